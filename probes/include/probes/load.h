@@ -1,5 +1,6 @@
 // probes/load.h: reading HDR environment maps with OpenImageIO (EXR, HDR, and anything else
-// it reads; 8-bit formats are taken as sRGB-encoded and linearised by OpenImageIO).
+// it reads). Integer formats (PNG, JPEG, ...) are decoded to linear values on load from the
+// colour space OpenImageIO reports: sRGB, or a stated gamma; sRGB when none is named.
 //
 // Layouts:
 //  - lat-long: width == 2 * height (see probes/probe.h for the direction mapping);
