@@ -1,0 +1,124 @@
+// meshes/frames.cpp: per-vertex normals and a continuous tangent field.
+//
+// Normals: angle-weighted pseudo-normals (Thürmer & Wüthrich 1998, "Computing vertex normals
+// from polygonal facets") or area weighting (the unnormalised face normal, Gouraud 1971).
+// Tangents: one reference axis for the whole mesh, projected into each tangent plane. By the
+// hairy-ball theorem any tangent field on a closed surface has singular points; this one has
+// them only where the normal is parallel to the reference axis, and the axis is chosen among
+// X, Y, Z as the one the normals avoid most (smallest sum of |n . axis|^8; the high power
+// makes the sum count the near-parallel normals, not the broad distribution).
+#include "meshes/frames.h"
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+
+namespace meshes {
+
+namespace {
+
+using Vec3d = Eigen::Vector3d;
+
+// Beyond |n . reference| = 0.9999 (0.81 degrees from parallel) the projected reference is
+// shorter than 0.014 and its direction is dominated by rounding; switch axis there.
+constexpr double kParallelLimit = 0.9999;
+
+const std::array<Vec3d, 3> kAxes = {Vec3d::UnitX(), Vec3d::UnitY(), Vec3d::UnitZ()};
+
+// The world axis least aligned with n (ties go to the first of X, Y, Z).
+Vec3d least_aligned_axis(const Vec3d& n) {
+  int best = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (std::abs(n[k]) < std::abs(n[best])) best = k;
+  }
+  return kAxes[best];
+}
+
+Vec3d tangent_from_reference_d(const Vec3d& n, const Vec3d& reference) {
+  Vec3d ref = reference;
+  const double ref_norm = ref.norm();
+  if (!(ref_norm > 0.0) || std::abs(n.dot(ref)) > kParallelLimit * ref_norm) {
+    ref = least_aligned_axis(n);
+  }
+  Vec3d t = ref - ref.dot(n) * n;
+  return t.normalized();
+}
+
+}  // namespace
+
+Vec3 tangent_from_reference(const Vec3& n, const Vec3& reference) {
+  Vec3d nd = n.cast<double>();
+  const double len = nd.norm();
+  nd = len > 0.0 ? Vec3d(nd / len) : Vec3d::UnitY();
+  return tangent_from_reference_d(nd, reference.cast<double>()).cast<float>();
+}
+
+void compute_frames(Mesh& mesh, NormalWeighting weighting) {
+  const std::size_t n = mesh.positions.size();
+  std::vector<Vec3d> sums(n, Vec3d::Zero());
+  std::vector<bool> touched(n, false);
+
+  for (const Triangle& tri : mesh.triangles) {
+    const std::array<Vec3d, 3> p = {mesh.positions[tri[0]].cast<double>(),
+                                    mesh.positions[tri[1]].cast<double>(),
+                                    mesh.positions[tri[2]].cast<double>()};
+    const Vec3d cross = (p[1] - p[0]).cross(p[2] - p[0]);
+    const double len = cross.norm();
+    for (std::uint32_t v : tri) touched[v] = true;
+    if (!(len > 0.0)) continue;  // a zero-area face has no normal to contribute
+    if (weighting == NormalWeighting::kArea) {
+      for (std::uint32_t v : tri) sums[v] += cross;  // |cross| = twice the area
+      continue;
+    }
+    const Vec3d unit = cross / len;
+    for (int c = 0; c < 3; ++c) {
+      const Vec3d e1 = p[(c + 1) % 3] - p[c];
+      const Vec3d e2 = p[(c + 2) % 3] - p[c];
+      const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+      sums[tri[c]] += angle * unit;
+    }
+  }
+
+  // Normals; vertices without a face (or whose faces cancel) get +Y.
+  std::vector<Vec3d> normals(n);
+  std::vector<bool> has_normal(n, false);
+  for (std::size_t v = 0; v < n; ++v) {
+    const double len = sums[v].norm();
+    if (touched[v] && len > 0.0 && std::isfinite(len)) {
+      normals[v] = sums[v] / len;
+      has_normal[v] = true;
+    } else {
+      normals[v] = Vec3d::UnitY();
+    }
+  }
+
+  // The reference axis the surface's normals avoid most.
+  std::array<double, 3> score = {0.0, 0.0, 0.0};
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!has_normal[v]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const double c2 = normals[v][k] * normals[v][k];
+      const double c4 = c2 * c2;
+      score[k] += c4 * c4;
+    }
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (score[k] < score[axis]) axis = k;
+  }
+  const Vec3d reference = kAxes[axis];
+
+  mesh.normals.resize(n);
+  mesh.tangents.resize(n);
+  mesh.bitangents.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const Vec3d& nv = normals[v];
+    const Vec3d t = tangent_from_reference_d(nv, reference);
+    const Vec3d b = nv.cross(t);
+    mesh.normals[v] = nv.cast<float>();
+    mesh.tangents[v] = t.cast<float>();
+    mesh.bitangents[v] = b.cast<float>();
+  }
+}
+
+}  // namespace meshes

@@ -1,0 +1,492 @@
+// meshes/load.cpp: OBJ/PLY/OFF/STL through OpenMesh's IO layer, then clean-up (weld, drop
+// degenerate and unreferenced, frames).
+//
+// OpenMesh is used only for parsing. Its readers feed a BaseImporter; OpenMesh's own
+// ImporterT builds a halfedge mesh, which cannot hold non-manifold ("complex") faces: it
+// either drops them or, in OpenMesh 9, duplicates their vertices, and both silently change
+// the mesh. CollectingImporter below keeps the raw vertex and polygon lists instead, so every
+// face the reader delivers reaches the clean-up and is counted in LoadReport. (On the Stanford
+// bunny OpenMesh 9's PolyMesh happens to keep all 69,666 faces; non-manifold inputs such as
+// the "fin" in meshes_test would not survive it unchanged.)
+//
+// Welding uses a uniform hash grid with cells as large as the weld distance: two points
+// within that distance lie in the same or in neighbouring cells, so each vertex checks the
+// 27 cells around it. Vertices are visited in index order and each merges into the lowest
+// index within reach, so the result does not depend on hash-table order.
+#include "meshes/load.h"
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <system_error>
+#include <unordered_map>
+#include <vector>
+
+namespace meshes {
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace omio = OpenMesh::IO;
+
+// Relative to the squared bounding-box diagonal: a triangle whose doubled area is below this
+// is a sliver of float rounding, with no usable normal.
+constexpr double kDegenerateAreaRatio = 1e-12;
+
+// Below this relative tolerance the weld distance is under float resolution for coordinates
+// of the size of the mesh, and grid cell coordinates could overflow; weld exact matches only.
+constexpr double kSmallestGridTolerance = 1e-15;
+
+constexpr std::array<const char*, 4> kFormats = {"obj", "ply", "off", "stl"};
+
+std::string supported_list() {
+  std::string out;
+  for (const char* f : kFormats) {
+    if (!out.empty()) out += ", ";
+    out += ".";
+    out += f;
+  }
+  return out;
+}
+
+std::string describe(const Vec3& v) {
+  std::ostringstream out;
+  out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return out.str();
+}
+
+// --- Reading ---------------------------------------------------------------------------------
+
+// Collects what a reader parses: positions and polygons as index lists, nothing else.
+class CollectingImporter final : public omio::BaseImporter {
+ public:
+  std::vector<Vec3> positions;
+  std::vector<std::uint32_t> corners;        // all faces' indices, concatenated
+  std::vector<std::size_t> face_offsets{0};  // face f is corners[offsets[f], offsets[f+1])
+  // The first face that names a vertex that does not exist, if any.
+  bool has_bad_face = false;
+  std::size_t bad_face = 0;
+  long long bad_index = 0;
+
+  std::size_t face_count() const { return face_offsets.size() - 1; }
+
+  OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3f& p) override {
+    positions.emplace_back(p[0], p[1], p[2]);
+    return OpenMesh::VertexHandle(static_cast<int>(positions.size() - 1));
+  }
+  OpenMesh::VertexHandle add_vertex(const OpenMesh::Vec3d& p) override {
+    return add_vertex(OpenMesh::Vec3f(p));
+  }
+  OpenMesh::VertexHandle add_vertex() override { return add_vertex(OpenMesh::Vec3f(0, 0, 0)); }
+  void set_point(OpenMesh::VertexHandle vh, const OpenMesh::Vec3f& p) override {
+    if (vh.is_valid() && static_cast<std::size_t>(vh.idx()) < positions.size()) {
+      positions[static_cast<std::size_t>(vh.idx())] = Vec3(p[0], p[1], p[2]);
+    }
+  }
+
+  OpenMesh::FaceHandle add_face(const VHandles& handles) override {
+    for (const OpenMesh::VertexHandle& h : handles) {
+      const long long idx = h.idx();
+      if (idx < 0 || static_cast<std::size_t>(idx) >= positions.size()) {
+        if (!has_bad_face) {
+          has_bad_face = true;
+          bad_face = face_count();
+          bad_index = idx;
+        }
+        corners.push_back(0);
+      } else {
+        corners.push_back(static_cast<std::uint32_t>(idx));
+      }
+    }
+    face_offsets.push_back(corners.size());
+    return OpenMesh::FaceHandle(static_cast<int>(face_count() - 1));
+  }
+
+  void reserve(unsigned int vertices, unsigned int /*edges*/, unsigned int faces) override {
+    positions.reserve(vertices);
+    face_offsets.reserve(std::size_t{faces} + 1);
+    corners.reserve(3 * std::size_t{faces});
+  }
+  size_t n_vertices() const override { return positions.size(); }
+  size_t n_faces() const override { return face_count(); }
+  size_t n_edges() const override { return 0; }
+
+  // Everything below is data we do not use (or halfedge connectivity, which only the .om
+  // format sends); ignoring it is the point of this importer.
+  OpenMesh::HalfedgeHandle add_edge(OpenMesh::VertexHandle, OpenMesh::VertexHandle) override {
+    return OpenMesh::HalfedgeHandle();
+  }
+  OpenMesh::FaceHandle add_face(OpenMesh::HalfedgeHandle) override {
+    return OpenMesh::FaceHandle();
+  }
+  void add_face_texcoords(OpenMesh::FaceHandle, OpenMesh::VertexHandle,
+                          const std::vector<OpenMesh::Vec2f>&) override {}
+  void add_face_texcoords(OpenMesh::FaceHandle, OpenMesh::VertexHandle,
+                          const std::vector<OpenMesh::Vec3f>&) override {}
+  void set_face_texindex(OpenMesh::FaceHandle, int) override {}
+  void set_halfedge(OpenMesh::VertexHandle, OpenMesh::HalfedgeHandle) override {}
+  void set_normal(OpenMesh::VertexHandle, const OpenMesh::Vec3f&) override {}
+  void set_normal(OpenMesh::VertexHandle, const OpenMesh::Vec3d&) override {}
+  void set_normal(OpenMesh::FaceHandle, const OpenMesh::Vec3f&) override {}
+  void set_normal(OpenMesh::FaceHandle, const OpenMesh::Vec3d&) override {}
+  void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec3uc&) override {}
+  void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec4uc&) override {}
+  void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec3f&) override {}
+  void set_color(OpenMesh::VertexHandle, const OpenMesh::Vec4f&) override {}
+  void set_color(OpenMesh::EdgeHandle, const OpenMesh::Vec3uc&) override {}
+  void set_color(OpenMesh::EdgeHandle, const OpenMesh::Vec4uc&) override {}
+  void set_color(OpenMesh::EdgeHandle, const OpenMesh::Vec3f&) override {}
+  void set_color(OpenMesh::EdgeHandle, const OpenMesh::Vec4f&) override {}
+  void set_color(OpenMesh::FaceHandle, const OpenMesh::Vec3uc&) override {}
+  void set_color(OpenMesh::FaceHandle, const OpenMesh::Vec4uc&) override {}
+  void set_color(OpenMesh::FaceHandle, const OpenMesh::Vec3f&) override {}
+  void set_color(OpenMesh::FaceHandle, const OpenMesh::Vec4f&) override {}
+  void set_texcoord(OpenMesh::VertexHandle, const OpenMesh::Vec2f&) override {}
+  void set_texcoord(OpenMesh::VertexHandle, const OpenMesh::Vec3f&) override {}
+  void set_texcoord(OpenMesh::HalfedgeHandle, const OpenMesh::Vec2f&) override {}
+  void set_texcoord(OpenMesh::HalfedgeHandle, const OpenMesh::Vec3f&) override {}
+  void set_status(OpenMesh::VertexHandle, const OpenMesh::Attributes::StatusInfo&) override {}
+  void set_status(OpenMesh::HalfedgeHandle, const OpenMesh::Attributes::StatusInfo&) override {}
+  void set_status(OpenMesh::EdgeHandle, const OpenMesh::Attributes::StatusInfo&) override {}
+  void set_status(OpenMesh::FaceHandle, const OpenMesh::Attributes::StatusInfo&) override {}
+  void set_next(OpenMesh::HalfedgeHandle, OpenMesh::HalfedgeHandle) override {}
+  void set_face(OpenMesh::HalfedgeHandle, OpenMesh::FaceHandle) override {}
+  void request_face_texcoords2D() override {}
+  void add_texture_information(int, std::string) override {}
+};
+
+// OpenMesh's readers are singletons with per-read state (the OFF reader keeps the options it
+// detected in a member), so reads are serialised.
+std::mutex& reader_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+// Binary STL is exactly 84 + 50 n bytes for the n in its header. OpenMesh decides by whether
+// the file starts with "solid", which many binary exporters also write into their header, so
+// we decide here by size and tell the reader.
+bool is_binary_stl(const fs::path& path, std::uintmax_t size) {
+  if (size < 84) return false;
+  std::ifstream in(path, std::ios::binary);
+  char header[84];
+  if (!in.read(header, sizeof(header))) return false;
+  const auto* b = reinterpret_cast<const unsigned char*>(header + 80);
+  const std::uintmax_t n = std::uintmax_t{b[0]} | (std::uintmax_t{b[1]} << 8) |
+                           (std::uintmax_t{b[2]} << 16) | (std::uintmax_t{b[3]} << 24);
+  return size == 84 + 50 * n;
+}
+
+// --- Welding -----------------------------------------------------------------------------------
+
+struct CellKey {
+  std::int64_t x, y, z;
+  bool operator==(const CellKey&) const = default;
+};
+
+struct CellHash {
+  std::size_t operator()(const CellKey& k) const {
+    // splitmix64 finaliser over a combination of the three coordinates.
+    std::uint64_t h = static_cast<std::uint64_t>(k.x) * 0x9E3779B97F4A7C15ull;
+    h ^= static_cast<std::uint64_t>(k.y) + 0x632BE59BD9B4E019ull + (h << 6) + (h >> 2);
+    h ^= static_cast<std::uint64_t>(k.z) + 0x8CB92BA72F3D8DD7ull + (h << 6) + (h >> 2);
+    h ^= h >> 30;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 27;
+    h *= 0x94D049BB133111EBull;
+    h ^= h >> 31;
+    return static_cast<std::size_t>(h);
+  }
+};
+
+// remap[v] = the vertex v merges into (v itself when it survives).
+std::vector<std::uint32_t> weld_map(const std::vector<Vec3>& positions, double tolerance,
+                                    const Bounds& box) {
+  const std::size_t n = positions.size();
+  std::vector<std::uint32_t> remap(n);
+  for (std::size_t v = 0; v < n; ++v) remap[v] = static_cast<std::uint32_t>(v);
+  if (tolerance < 0.0 || n == 0) return remap;
+
+  const double diagonal = box.diagonal();
+  const double eps = tolerance * diagonal;
+  if (!(tolerance >= kSmallestGridTolerance) || !(eps > 0.0)) {
+    // Exact matches only (+0 and -0 are the same point).
+    std::unordered_map<CellKey, std::uint32_t, CellHash> first;
+    first.reserve(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      const Vec3& p = positions[v];
+      const CellKey key{std::bit_cast<std::int32_t>(p.x() + 0.f),
+                        std::bit_cast<std::int32_t>(p.y() + 0.f),
+                        std::bit_cast<std::int32_t>(p.z() + 0.f)};
+      const auto [it, inserted] = first.try_emplace(key, static_cast<std::uint32_t>(v));
+      if (!inserted) remap[v] = it->second;
+    }
+    return remap;
+  }
+
+  const Eigen::Vector3d origin = box.min.cast<double>();
+  const double eps2 = eps * eps;
+  std::unordered_map<CellKey, std::vector<std::uint32_t>, CellHash> grid;
+  grid.reserve(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const Eigen::Vector3d p = positions[v].cast<double>();
+    const Eigen::Vector3d c = ((p - origin) / eps).array().floor();
+    const CellKey cell{static_cast<std::int64_t>(c.x()), static_cast<std::int64_t>(c.y()),
+                       static_cast<std::int64_t>(c.z())};
+    std::uint32_t best = static_cast<std::uint32_t>(v);
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      for (std::int64_t dy = -1; dy <= 1; ++dy) {
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+          const auto it = grid.find({cell.x + dx, cell.y + dy, cell.z + dz});
+          if (it == grid.end()) continue;
+          for (std::uint32_t r : it->second) {
+            if (r < best && (positions[r].cast<double>() - p).squaredNorm() <= eps2) best = r;
+          }
+        }
+      }
+    }
+    if (best == v) {
+      grid[cell].push_back(best);
+    } else {
+      remap[v] = best;
+    }
+  }
+  return remap;
+}
+
+// --- Clean-up ----------------------------------------------------------------------------------
+
+struct CleanCounts {
+  std::size_t welded = 0;
+  std::size_t degenerate = 0;
+  std::size_t unreferenced = 0;
+};
+
+// Welds, drops degenerate triangles and unused vertices, computes frames. `name` starts every
+// error message.
+CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& name) {
+  // Structural problems are the caller's (in-memory meshes) or were reported by the loader.
+  {
+    Mesh bare;
+    bare.positions = mesh.positions;  // validate without frames: they are recomputed below
+    bare.triangles = mesh.triangles;
+    validate(bare, name);
+  }
+  CleanCounts counts;
+  const std::size_t triangles_in = mesh.triangles.size();
+  const Bounds box = bounds(mesh);
+  const double diagonal = box.diagonal();
+
+  const std::vector<std::uint32_t> remap = weld_map(mesh.positions, options.weld_tolerance, box);
+  for (std::size_t v = 0; v < remap.size(); ++v) {
+    if (remap[v] != v) ++counts.welded;
+  }
+
+  const double min_double_area = kDegenerateAreaRatio * diagonal * diagonal;
+  std::vector<Triangle> kept;
+  kept.reserve(mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles) {
+    const Triangle w = {remap[t[0]], remap[t[1]], remap[t[2]]};
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) {
+      ++counts.degenerate;
+      continue;
+    }
+    const double area2 = double_area(mesh, w);
+    if (!(area2 > 0.0) || area2 < min_double_area) {
+      ++counts.degenerate;
+      continue;
+    }
+    kept.push_back(w);
+  }
+
+  // Compact: survivors keep their relative order.
+  constexpr std::uint32_t kUnused = 0xFFFFFFFFu;
+  std::vector<std::uint32_t> new_index(mesh.positions.size(), kUnused);
+  for (const Triangle& t : kept) {
+    for (std::uint32_t v : t) new_index[v] = 0;
+  }
+  std::vector<Vec3> positions;
+  positions.reserve(mesh.positions.size());
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (new_index[v] == kUnused) {
+      if (remap[v] == v) ++counts.unreferenced;  // welded vertices are counted as welded
+      continue;
+    }
+    new_index[v] = static_cast<std::uint32_t>(positions.size());
+    positions.push_back(mesh.positions[v]);
+  }
+  for (Triangle& t : kept) {
+    for (std::uint32_t& v : t) v = new_index[v];
+  }
+
+  if (kept.empty()) {
+    std::ostringstream msg;
+    msg << name << ": no faces left after clean-up: all " << triangles_in
+        << " triangle(s) are degenerate (a repeated vertex, or zero area, after welding "
+           "points closer than "
+        << options.weld_tolerance
+        << " x the bounding-box diagonal); check that the file holds a surface and, if its "
+           "details are tiny next to its extent, lower LoadOptions::weld_tolerance";
+    throw MeshError(msg.str());
+  }
+
+  mesh.positions = std::move(positions);
+  mesh.triangles = std::move(kept);
+  mesh.normals.clear();
+  mesh.tangents.clear();
+  mesh.bitangents.clear();
+  compute_frames(mesh, options.normal_weighting);
+  return counts;
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string upper(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  return s;
+}
+
+}  // namespace
+
+void clean_mesh(Mesh& mesh, const LoadOptions& options, LoadReport* report) {
+  const std::size_t vertices_in = mesh.positions.size();
+  const std::size_t triangles_in = mesh.triangles.size();
+  const std::string name =
+      report != nullptr && !report->path.empty() ? report->path : std::string("in-memory mesh");
+  const CleanCounts counts = clean(mesh, options, name);
+  if (report != nullptr) {
+    report->file_vertices = vertices_in;
+    report->file_faces = triangles_in;
+    report->triangles_after_triangulation = triangles_in;
+    report->polygons_triangulated = 0;
+    report->degenerate_faces_dropped = counts.degenerate;
+    report->vertices_welded = counts.welded;
+    report->unreferenced_vertices_dropped = counts.unreferenced;
+  }
+}
+
+Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* report) {
+  const std::string name = path.string();
+  const auto fail = [&](const std::string& problem) -> MeshError {
+    return MeshError(name + ": " + problem);
+  };
+
+  // File-system problems first, each with its own fix.
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) {
+    throw fail("cannot be inspected (" + ec.message() + "); check the path and permissions");
+  }
+  if (!fs::exists(status)) {
+    throw fail("no such file; check the path (relative paths start at " +
+               fs::current_path(ec).string() + ")");
+  }
+  if (fs::is_directory(status)) {
+    throw fail("is a directory, not a mesh file; name a " + supported_list() + " file inside it");
+  }
+  const std::string extension = path.extension().string();
+  const std::string format = lower(extension.empty() ? extension : extension.substr(1));
+  if (std::find(kFormats.begin(), kFormats.end(), format) == kFormats.end()) {
+    throw fail("unknown mesh format (" +
+               (extension.empty() ? std::string("no extension") : "'" + extension + "'") +
+               "); supported extensions are " + supported_list() +
+               " (rename the file if it is one of these, or convert it, e.g. with meshlab)");
+  }
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
+  if (size == 0) throw fail("the file is empty (0 bytes); re-export the mesh");
+  if (!std::ifstream(path, std::ios::binary)) {
+    throw fail("cannot be opened for reading; check its permissions");
+  }
+
+  // Parse.
+  CollectingImporter importer;
+  bool parsed = false;
+  {
+    const std::lock_guard<std::mutex> lock(reader_mutex());
+    omio::Options opt;
+    if (format == "stl") {
+      // Through the stream interface, so the binary/ASCII decision is ours.
+      const bool binary = is_binary_stl(path, size);
+      std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
+      if (binary) opt += omio::Options::Binary;
+      parsed = omio::IOManager().read(in, ".stl", importer, opt);
+    } else {
+      // OpenMesh picks the reader by the extension (case-insensitively).
+      parsed = omio::IOManager().read(path.string(), importer, opt);
+    }
+  }
+  if (!parsed) {
+    throw fail("OpenMesh could not parse this file as " + upper(format) +
+               "; check that it is a valid ." + format + " file (re-export it if unsure)");
+  }
+  if (importer.has_bad_face) {
+    std::ostringstream msg;
+    msg << "face " << importer.bad_face << " (0-based, in file order) refers to vertex "
+        << importer.bad_index << ", which does not exist (the reader found "
+        << importer.positions.size()
+        << " vertices); a vertex line may be malformed (OpenMesh's text readers skip "
+           "coordinates they cannot parse, such as 'nan' or 'inf'); fix the file";
+    throw fail(msg.str());
+  }
+  if (importer.positions.empty() && importer.face_count() == 0) {
+    throw fail("no vertices and no faces found; check that this is really a ." + format +
+               " mesh file (the " + upper(format) + " reader skips lines it does not know)");
+  }
+  if (importer.face_count() == 0) {
+    throw fail("the file has no faces, only " + std::to_string(importer.positions.size()) +
+               " vertices; a point cloud cannot be baked, export the surface with its faces");
+  }
+  for (std::size_t v = 0; v < importer.positions.size(); ++v) {
+    if (!importer.positions[v].allFinite()) {
+      throw fail("vertex " + std::to_string(v) +
+                 " (0-based, in file order) has a non-finite "
+                 "coordinate " +
+                 describe(importer.positions[v]) + "; fix or remove it");
+    }
+  }
+
+  // Fan-triangulate: corners c0 ... c(k-1) give (c0, ci, ci+1). A face with fewer than three
+  // corners has no area and counts as one degenerate triangle.
+  LoadReport local;
+  local.path = name;
+  local.format = format;
+  local.file_vertices = importer.positions.size();
+  local.file_faces = importer.face_count();
+  Mesh mesh;
+  mesh.positions = std::move(importer.positions);
+  std::size_t short_faces = 0;
+  for (std::size_t f = 0; f < importer.face_count(); ++f) {
+    const std::size_t begin = importer.face_offsets[f];
+    const std::size_t k = importer.face_offsets[f + 1] - begin;
+    if (k < 3) {
+      ++short_faces;
+      continue;
+    }
+    if (k > 3) ++local.polygons_triangulated;
+    const std::uint32_t* c = importer.corners.data() + begin;
+    for (std::size_t i = 1; i + 1 < k; ++i) mesh.triangles.push_back({c[0], c[i], c[i + 1]});
+  }
+  local.triangles_after_triangulation = mesh.triangles.size() + short_faces;
+
+  const CleanCounts counts = clean(mesh, options, name);
+  local.degenerate_faces_dropped = counts.degenerate + short_faces;
+  local.vertices_welded = counts.welded;
+  local.unreferenced_vertices_dropped = counts.unreferenced;
+  validate(mesh, name);
+  if (report != nullptr) *report = local;
+  return mesh;
+}
+
+}  // namespace meshes

@@ -25,21 +25,35 @@ struct LoadOptions {
 struct LoadReport {
   std::string path;
   std::string format;  // lower-case extension: "obj", "ply", "off", "stl"
+  // As OpenMesh's reader delivered them, which is not always every record in the file: its
+  // OBJ reader skips faces that repeat a vertex index or have fewer than three corners, and
+  // its STL reader merges bit-identical corners and skips triangles that repeat one. Such
+  // faces are in neither file_faces nor degenerate_faces_dropped.
   std::size_t file_vertices = 0;
   std::size_t file_faces = 0;
   std::size_t polygons_triangulated = 0;  // faces with more than three corners
+  // Triangles from fan-triangulating file_faces (a k-gon gives k - 2; a face with fewer than
+  // three corners counts as one degenerate triangle). Always equals the loaded mesh's
+  // triangle_count() + degenerate_faces_dropped.
+  std::size_t triangles_after_triangulation = 0;
   std::size_t degenerate_faces_dropped = 0;
-  std::size_t vertices_welded = 0;        // vertices merged into another
+  std::size_t vertices_welded = 0;  // vertices merged into another
   std::size_t unreferenced_vertices_dropped = 0;
 };
 
-// Throws MeshError naming the path for: a missing or unreadable file, an unknown extension,
-// an empty file, no faces left, or NaN/Inf coordinates.
+// Throws MeshError whose message starts with the path and says what to do, for: a missing or
+// unreadable file, a directory, an unknown extension, an empty file, content OpenMesh cannot
+// parse, a face naming a vertex that does not exist, NaN/Inf coordinates, or no faces (in
+// the file, or left after clean-up). The binary/ASCII decision for .stl is made by file size
+// (84 + 50 n bytes is binary), not by OpenMesh's "starts with solid" test.
 Mesh load_mesh(const std::filesystem::path& path, const LoadOptions& options = {},
                LoadReport* report = nullptr);
 
 // The same clean-up load_mesh applies, for meshes built in memory: weld, drop degenerate
-// and unreferenced, recompute frames. Counts go into `report` when given.
+// and unreferenced, recompute frames. Counts go into `report` when given (file_vertices and
+// file_faces are then the mesh's counts before clean-up; path and format are left as they
+// are, and a non-empty path names the mesh in errors). Throws MeshError for out-of-range
+// indices, NaN/Inf positions, or no faces left.
 void clean_mesh(Mesh& mesh, const LoadOptions& options = {}, LoadReport* report = nullptr);
 
 }  // namespace meshes

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // Vec3::cross, used by every user of the winding convention
 
 #include <array>
 #include <cstdint>

@@ -1,5 +1,7 @@
 // meshes/procedural.h: meshes built in code, for tests and examples. All come back with
-// frames computed and pass validate().
+// frames computed and pass validate(). Parameters that cannot make a mesh (non-positive
+// sizes, fewer than 3 segments, a torus with r >= R, a sphere not above the plane) throw
+// std::invalid_argument.
 #pragma once
 
 #include "meshes/mesh.h"
@@ -19,10 +21,10 @@ Mesh make_plane(float size = 4.f, int subdivisions = 16, float y = 0.f);
 
 // Occluder scene: a ground plane (y = 0, side `plane_size`) with a sphere of `radius`
 // whose centre is `height` above it. A point on the plane straight below the sphere sees
-// the sphere subtend a cone of half-angle asin(radius / height) about +Y.
-Mesh make_plane_and_sphere(float plane_size = 6.f, int plane_subdivisions = 24,
-                           float radius = 0.5f, float height = 1.5f, int segments = 32,
-                           int rings = 16);
+// the sphere subtend a cone of half-angle asin(radius / height) about +Y. Needs
+// height > radius.
+Mesh make_plane_and_sphere(float plane_size = 6.f, int plane_subdivisions = 24, float radius = 0.5f,
+                           float height = 1.5f, int segments = 32, int rings = 16);
 
 // Open box: five faces of the cube [-s/2, s/2]^3 with the +Y face missing, normals facing
 // inward, so the inside is a concave receiver; each face is a `subdivisions`^2 grid.
