@@ -1,0 +1,34 @@
+#include "cpca/metrics.h"
+
+#include <gtest/gtest.h>
+
+namespace {
+
+TEST(Metrics, ErrorsMatchHandComputation) {
+  cpca::DataMatrix x(3, 2), y(3, 2);
+  x << 1, 2, 3, 4, 0, 0;
+  y << 1, 2, 2, 4, 0, 1;  // row errors 0, 1, 1
+  const cpca::ErrorMetrics m = cpca::error_metrics(x, y);
+  EXPECT_DOUBLE_EQ(m.average_squared_error, 2.0 / 3.0);
+  EXPECT_DOUBLE_EQ(m.relative_error, 2.0 / 30.0);
+  EXPECT_DOUBLE_EQ(m.max_squared_error, 1.0);
+  EXPECT_THROW(cpca::error_metrics(x, cpca::DataMatrix(2, 2)), std::invalid_argument);
+}
+
+TEST(Metrics, LargeInputIsDeterministicAndMatchesEigen) {
+  cpca::DataMatrix x = cpca::DataMatrix::Random(5000, 17), y = cpca::DataMatrix::Random(5000, 17);
+  const cpca::ErrorMetrics a = cpca::error_metrics(x, y), b = cpca::error_metrics(x, y);
+  EXPECT_EQ(a.average_squared_error, b.average_squared_error);
+  const double oracle = (x - y).cast<double>().squaredNorm() / 5000.0;
+  EXPECT_NEAR(a.average_squared_error, oracle, 1e-9 * oracle);
+}
+
+TEST(Metrics, ThesisSizeFormula) {
+  // Bunny, order 6 glossy grey (36*36 = 1296 numbers per vertex), 256 clusters, 8 PCs.
+  const cpca::SizeMetrics s = cpca::size_metrics(34835, 1296, 256, 8);
+  EXPECT_EQ(s.raw_numbers, 34835ull * 1296);
+  EXPECT_EQ(s.compressed_numbers, 34835ull * 8 + 256ull * 9 * 1296);
+  EXPECT_NEAR(s.ratio, 45146160.0 / 3264664.0, 1e-9);
+}
+
+}  // namespace

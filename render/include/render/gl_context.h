@@ -1,0 +1,49 @@
+// render/gl_context.h: an offscreen OpenGL context through OSMesa (Mesa's llvmpipe on the
+// CPU; no display, no GPU). The OSMesa and GL headers stay inside render/src.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace render {
+
+struct GlInfo {
+  std::string version;       // GL_VERSION
+  std::string renderer;      // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string glsl_version;  // GL_SHADING_LANGUAGE_VERSION
+  int major = 0, minor = 0;
+  bool core_profile = false;
+  int max_vertex_uniform_vectors = 0;  // the register budget's default (vec4 count)
+  int max_uniform_block_size = 0;      // bytes
+  long long max_ssbo_size = 0;         // bytes
+};
+
+class GlError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Owns the context and makes it current on the constructing thread. The default OSMesa
+// buffer is `width` x `height` RGBA8; the renderer draws into its own framebuffer objects.
+class GlContext {
+ public:
+  // Requests a core profile of at least major.minor; throws GlError with OSMesa's answer
+  // when Mesa cannot provide it.
+  explicit GlContext(int major = 4, int minor = 5, int width = 16, int height = 16);
+  ~GlContext();
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+
+  void make_current();
+  GlInfo info() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Throws GlError naming `where` and the GL error code(s) when glGetError reports any.
+void check_gl(const char* where);
+
+}  // namespace render
