@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# End-to-end tests of the prtr binary: exit codes (0 ok, 1 failure, 2 usage), error messages
+# that name the input, and values parsed from the output (a pattern that matches nothing is
+# a failure, never a pass).
+set -u
+prtr=$1
+tmp=$2
+rm -rf "$tmp" && mkdir -p "$tmp"
+passed=0
+failed=0
+
+check() {  # check NAME CONDITION-RESULT
+  if [[ $2 == 0 ]]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $1"; fi
+}
+run() {  # run ARGS...: sets out, err, code
+  out=$("$prtr" "$@" 2>"$tmp/err"); code=$?; err=$(cat "$tmp/err")
+}
+expect_code() { [[ $code == "$1" ]]; }
+
+# Usage.
+run --help; expect_code 0; check "--help exits 0" $?
+run; expect_code 2; check "no subcommand exits 2" $?
+run frobnicate; expect_code 2; check "unknown subcommand exits 2" $?
+run probe x.exr --order 11; expect_code 2; check "order 11 is a usage error" $?
+run probe x.exr --order 0; expect_code 2; check "order 0 is a usage error" $?
+run mesh a.obj --bogus; expect_code 2; check "unknown flag exits 2" $?
+
+# Failures name the input.
+run mesh "$tmp/missing.obj"; expect_code 1 && [[ $err == *missing.obj* ]]; check "missing mesh exits 1 naming it" $?
+: >"$tmp/empty.obj"
+run mesh "$tmp/empty.obj"; expect_code 1 && [[ $err == *empty.obj* ]]; check "empty mesh exits 1 naming it" $?
+run probe "$tmp/missing.exr"; expect_code 1 && [[ $err == *missing.exr* ]]; check "missing probe exits 1 naming it" $?
+echo "not an image" >"$tmp/garbage.exr"
+run probe "$tmp/garbage.exr"; expect_code 1 && [[ $err == *garbage.exr* ]]; check "corrupt probe exits 1 naming it" $?
+
+# A quad written as OBJ: 4 vertices, 2 triangles, 1 polygon triangulated.
+printf 'v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 4 3 2\n' >"$tmp/quad.obj"
+run mesh "$tmp/quad.obj"; expect_code 0; check "quad loads" $?
+[[ $out =~ result\ +4\ vertices,\ 2\ triangles ]]; check "quad: 4 vertices, 2 triangles" $?
+[[ $out =~ \(1\ polygons\ triangulated\) ]]; check "quad: 1 polygon triangulated" $?
+[[ $out =~ area\ +1($|[^0-9]) ]]; check "quad: area 1" $?
+
+# The real inputs, when installed.
+bunny=/usr/share/glmark2/models/bunny.obj
+if [[ -f $bunny ]]; then
+  run mesh "$bunny"; expect_code 0; check "bunny loads" $?
+  [[ $out =~ result\ +([0-9]+)\ vertices,\ ([0-9]+)\ triangles ]]; check "bunny: counts printed" $?
+  v=${BASH_REMATCH[1]:-0}; t=${BASH_REMATCH[2]:-0}
+  ((v > 34000 && v <= 34835)); check "bunny: ~34.8k vertices (got $v)" $?
+  ((t > 69000 && t <= 69666)); check "bunny: ~69.7k triangles (got $t)" $?
+fi
+forest=/usr/share/blender/datafiles/studiolights/world/forest.exr
+if [[ -f $forest ]]; then
+  run probe "$forest" --order 6; expect_code 0; check "forest loads" $?
+  rows=$(grep -cE '^ +[0-9]+ +-?[0-9]+ +[-0-9.e+]+ +[-0-9.e+]+ +[-0-9.e+]+$' <<<"$out")
+  [[ $rows == 36 ]]; check "forest: 36 coefficient rows (got $rows)" $?
+  dc=$(awk '$1 == 0 && $2 == 0 {print $3}' <<<"$out")
+  awk -v x="${dc:-0}" 'BEGIN { exit !(x > 0) }'; check "forest: positive DC term ($dc)" $?
+  [[ $out =~ 1024\ x\ 512 ]]; check "forest: 1024 x 512" $?
+fi
+
+run gl-info; expect_code 0 && [[ $out == *"Core"* || $out == *"core profile"* ]]; check "gl-info: core context" $?
+
+echo "cli: $passed passed, $failed failed"
+((failed == 0))

@@ -1,0 +1,59 @@
+// prtr mesh FILE: load a mesh the way every later stage will, and print what was found.
+#include "commands.h"
+
+#include "meshes/load.h"
+
+#include <cstdio>
+#include <string>
+
+namespace prtr_app {
+
+Runner add_mesh_command(CLI::App& app) {
+  struct Options {
+    std::string path;
+    double weld = meshes::LoadOptions{}.weld_tolerance;
+    std::string normals = "angle";
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd =
+      app.add_subcommand("mesh", "Load a mesh (OBJ, PLY, OFF, STL) and print its facts");
+  cmd->add_option("MESH", opt->path, "Mesh file")->required();
+  cmd->add_option("--weld-tolerance", opt->weld,
+                  "Weld positions closer than this fraction of the bounding-box diagonal "
+                  "(negative: no welding)")
+      ->capture_default_str();
+  cmd->add_option("--normals", opt->normals, "Vertex normal weighting")
+      ->check(CLI::IsMember({"angle", "area"}))
+      ->capture_default_str();
+
+  return [opt] {
+    meshes::LoadOptions options;
+    options.weld_tolerance = opt->weld;
+    options.normal_weighting =
+        opt->normals == "area" ? meshes::NormalWeighting::kArea : meshes::NormalWeighting::kAngle;
+    meshes::LoadReport report;
+    const meshes::Mesh mesh = meshes::load_mesh(opt->path, options, &report);
+    const meshes::Bounds b = meshes::bounds(mesh);
+    double area = 0.0;
+    for (const meshes::Triangle& t : mesh.triangles) area += 0.5 * meshes::double_area(mesh, t);
+
+    std::printf("mesh        %s (%s)\n", report.path.c_str(), report.format.c_str());
+    std::printf("file        %zu vertices, %zu faces (%zu polygons triangulated)\n",
+                report.file_vertices, report.file_faces, report.polygons_triangulated);
+    std::printf(
+        "clean-up    %zu vertices welded, %zu unreferenced dropped, %zu degenerate "
+        "faces dropped\n",
+        report.vertices_welded, report.unreferenced_vertices_dropped,
+        report.degenerate_faces_dropped);
+    std::printf("result      %zu vertices, %zu triangles\n", mesh.vertex_count(),
+                mesh.triangle_count());
+    std::printf("bounds      min (%.6g, %.6g, %.6g)  max (%.6g, %.6g, %.6g)\n", b.min.x(),
+                b.min.y(), b.min.z(), b.max.x(), b.max.y(), b.max.z());
+    std::printf("diagonal    %.6g\n", b.diagonal());
+    std::printf("area        %.6g\n", area);
+    std::printf("hash        %016llx\n",
+                static_cast<unsigned long long>(meshes::content_hash(mesh)));
+  };
+}
+
+}  // namespace prtr_app

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs every Debian package prtr needs (build tools, libraries, and the real inputs:
+# glmark2-data for the Stanford bunny, blender-data for the HDR probes), then configures and
+# builds in ./build. Idempotent and non-interactive: a second run installs nothing and
+# rebuilds only what changed. Debian 12 (bookworm); runs apt-get as root or through sudo.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
+  libopenimageio-dev libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
+  glmark2-data blender-data
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  sudo_cmd=()
+  if [[ $(id -u) -ne 0 ]]; then
+    command -v sudo >/dev/null || { echo "setup: need root or sudo to install packages" >&2; exit 1; }
+    sudo_cmd=(sudo)
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo_cmd[@]}" apt-get update -qq
+  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+else
+  echo "setup: all ${#packages[@]} packages present" >&2
+fi
+
+build_type=${PRTR_BUILD_TYPE:-Release}
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
+cmake --build build -j "$(nproc)"
