@@ -2,6 +2,8 @@
 // content hash later stages use to tie a bake to the exact mesh it was made from.
 #include "meshes/mesh.h"
 
+#include "common/hash.h"
+
 #include <cmath>
 #include <sstream>
 
@@ -21,19 +23,6 @@ std::string describe(const Vec3& v) {
 
 [[noreturn]] void fail(const std::string& what, const std::string& problem) {
   throw MeshError(what + ": " + problem);
-}
-
-// FNV-1a, 64-bit (http://www.isthe.com/chongo/tech/comp/fnv/).
-constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
-constexpr std::uint64_t kFnvPrime = 1099511628211ull;
-
-std::uint64_t fnv1a(std::uint64_t hash, const void* data, std::size_t bytes) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < bytes; ++i) {
-    hash ^= p[i];
-    hash *= kFnvPrime;
-  }
-  return hash;
 }
 
 }  // namespace
@@ -107,15 +96,15 @@ void validate(const Mesh& mesh, const std::string& what) {
 }
 
 std::uint64_t content_hash(const Mesh& mesh) {
-  std::uint64_t hash = kFnvOffset;
+  std::uint64_t hash = common::kFnvOffset;
   // Component by component, so the hash never depends on how Eigen lays out or pads Vec3.
   for (const Vec3& p : mesh.positions) {
     const float xyz[3] = {p.x(), p.y(), p.z()};
-    hash = fnv1a(hash, xyz, sizeof(xyz));
+    hash = common::fnv1a(xyz, sizeof(xyz), hash);
   }
   for (const Triangle& t : mesh.triangles) {
     const std::uint32_t idx[3] = {t[0], t[1], t[2]};
-    hash = fnv1a(hash, idx, sizeof(idx));
+    hash = common::fnv1a(idx, sizeof(idx), hash);
   }
   return hash;
 }

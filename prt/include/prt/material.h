@@ -1,0 +1,66 @@
+// prt/material.h: reflectance models and their SH BRDF matrices.
+//
+// All BRDFs are isotropic and evaluated in the local frame (z = normal): v points toward the
+// viewer, s toward the light, both unit; f_r is zero when v.z <= 0 or s.z <= 0.
+//  - Lambert:       f = rho_d / pi
+//  - Phong:         f = rho_d / pi + rho_s (e + 2) / (2 pi) max(0, r.v)^e, r = 2 (s.z) z - s
+//                   (the energy-normalised "modified Phong" of Lafortune & Willems 1994)
+//  - Cook-Torrance: f = rho_d / pi + rho_s D(h) G(v, s) F(v.h) / (4 v.z s.z), h = (v+s)/|v+s|
+//                   D Beckmann with roughness m, G the original Cook-Torrance masking term
+//                   min(1, 2 h.z v.z / v.h, 2 h.z s.z / v.h), F Fresnel-Schlick with f0.
+// rho_d is RGB; when its three channels are equal the material is grey and transfer needs one
+// channel, otherwise three (rho_s, e, m and f0 are the same for all channels).
+//
+// BRDF matrix (DESIGN.md, "The math"), for one channel:
+//     B_ij = int_{v.z>0} int_{s.z>0} y_i(v) f_r(v, s) s.z y_j(s) ds dv
+// so that exit radiance toward local v is y(v)^T B l_local for local incident lighting l_local.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <string>
+
+namespace prt {
+
+enum class MaterialKind { kLambert, kPhong, kCookTorrance };
+
+struct Material {
+  MaterialKind kind = MaterialKind::kPhong;
+  Eigen::Vector3f albedo = Eigen::Vector3f::Constant(0.5f);  // rho_d per channel, in [0, 1]
+  float specular = 0.3f;    // rho_s in [0, 1]; rho_d + rho_s <= 1 per channel
+  float exponent = 32.f;    // Phong e in [0, 10000]
+  float roughness = 0.3f;   // Cook-Torrance Beckmann m in (0, 1]
+  float f0 = 0.04f;         // Fresnel reflectance at normal incidence, in [0, 1]
+
+  bool grey() const { return albedo.x() == albedo.y() && albedo.y() == albedo.z(); }
+  int channels() const { return grey() ? 1 : 3; }
+  // Throws std::invalid_argument naming the parameter (as its CLI flag, e.g. "--exponent")
+  // and the allowed range.
+  void validate() const;
+};
+
+const char* material_name(MaterialKind kind);  // "lambert", "phong", "cook-torrance"
+// Parses a name as printed by material_name; throws std::invalid_argument listing the names.
+MaterialKind parse_material(const std::string& name);
+
+// f_r for one channel (0..2; a grey material ignores it). Local frame, unit vectors.
+double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,
+                 const Eigen::Vector3d& s);
+
+struct BrdfQuadrature {
+  // Gauss-Legendre nodes in cos(theta) x uniform nodes in phi, for the view (v) and light (s)
+  // hemispheres. 0 = chosen from the material (sharper lobes get finer s grids).
+  int view_theta = 0, view_phi = 0, light_theta = 0, light_phi = 0;
+};
+
+// n x n BRDF matrix (n = order^2) for one channel, by product quadrature. Cost is dominated
+// by f_r evaluations (view nodes x light nodes) and runs in parallel; a glossy Phong lobe at
+// order 6 takes well under a second.
+Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
+                            const BrdfQuadrature& quadrature = {});
+
+// Lambert's B in closed form: (rho / pi) a b^T with a_l = int y_l^0 over the hemisphere and
+// b_l the clamped-cosine zonal coefficients, non-zero only on m = 0 entries (rank one).
+Eigen::MatrixXd lambert_brdf_matrix(double albedo, int order);
+
+}  // namespace prt
