@@ -1,0 +1,420 @@
+// The .prtx transfer file, version 1. docs/FORMATS.md ("Transfer file (.prtx), version 1")
+// is the byte-by-byte description; the offsets below must stay in step with its table.
+//
+// The header is serialised field by field at fixed offsets (never by writing a struct, whose
+// padding and layout are the compiler's), little-endian, with its own checksum so that a
+// damaged seed or mesh hash is caught too, not only a damaged payload. The payload is
+// TransferSet::data as is: written and read in one call each, never copied or parsed per
+// element, because a bunny bake is ~180 MB.
+#include "prt/transfer_file.h"
+
+#include "common/atomic_file.h"
+#include "common/hash.h"
+
+#include <array>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <type_traits>
+
+namespace prt {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The payload is written straight from memory, so the host must already be little-endian.
+static_assert(std::endian::native == std::endian::little,
+              "the .prtx format is little-endian; add byte swapping for big-endian hosts");
+static_assert(sizeof(float) == 4 && std::numeric_limits<float>::is_iec559);
+static_assert(sizeof(std::size_t) >= 8, "payloads may exceed 4 GiB");
+
+// --- Layout (docs/FORMATS.md) ----------------------------------------------------------------
+constexpr std::size_t kHeaderBytes = 128;
+constexpr std::array<char, 8> kMagic = {'P', 'R', 'T', 'R', 'X', 'F', 'E', 'R'};
+
+constexpr std::size_t kOffMagic = 0;              // char[8]
+constexpr std::size_t kOffVersion = 8;            // u32
+constexpr std::size_t kOffHeaderBytes = 12;       // u32
+constexpr std::size_t kOffKind = 16;              // u32
+constexpr std::size_t kOffOrder = 20;             // u32
+constexpr std::size_t kOffChannels = 24;          // u32
+constexpr std::size_t kOffSamples = 28;           // u32
+constexpr std::size_t kOffBounces = 32;           // u32
+constexpr std::size_t kOffMaterialKind = 36;      // u32
+constexpr std::size_t kOffVertexCount = 40;       // u64
+constexpr std::size_t kOffSeed = 48;              // u64
+constexpr std::size_t kOffMeshHash = 56;          // u64
+constexpr std::size_t kOffAlbedo = 64;            // f32[3]
+constexpr std::size_t kOffSpecular = 76;          // f32
+constexpr std::size_t kOffExponent = 80;          // f32
+constexpr std::size_t kOffRoughness = 84;         // f32
+constexpr std::size_t kOffF0 = 88;                // f32
+constexpr std::size_t kOffReserved0 = 92;         // u32, zero
+constexpr std::size_t kOffPayloadFloats = 96;     // u64
+constexpr std::size_t kOffPayloadChecksum = 104;  // u64
+constexpr std::size_t kOffReserved1 = 112;        // u64, zero
+constexpr std::size_t kOffHeaderChecksum = 120;   // u64, FNV-1a of bytes [0, 120)
+static_assert(kOffHeaderChecksum + 8 == kHeaderBytes);
+
+// --- Ranges ------------------------------------------------------------------------------------
+constexpr std::int64_t kMaxOrder = 10;
+constexpr std::int64_t kMaxBounces = 16;
+constexpr std::uint64_t kMaxVertexCount = std::uint64_t(1) << 40;
+constexpr float kMaxExponent = 10000.f;
+
+constexpr const char* kRebake = "bake it again with prtr bake";
+
+using Header = std::array<unsigned char, kHeaderBytes>;
+
+template <class T>
+void put(Header& h, std::size_t offset, T value) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  std::memcpy(h.data() + offset, &value, sizeof(T));
+}
+
+template <class T>
+T get(const Header& h, std::size_t offset) {
+  T value;
+  std::memcpy(&value, h.data() + offset, sizeof(T));
+  return value;
+}
+
+std::string hex(std::uint64_t v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+std::string num(float v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.9g", static_cast<double>(v));
+  return buf;
+}
+
+// The header values that have a range, widened so that the writer (ints) and the reader
+// (u32/u64 from disk) share one check.
+struct Fields {
+  std::int64_t kind = 0, order = 0, channels = 0, samples = 0, bounces = 0, material_kind = 0;
+  std::uint64_t vertex_count = 0;
+  float albedo[3] = {0, 0, 0};
+  float specular = 0, exponent = 0, roughness = 0, f0 = 0;
+};
+
+Fields fields_of(const TransferSet& set) {
+  Fields f;
+  f.kind = static_cast<std::int64_t>(set.kind);
+  f.order = set.order;
+  f.channels = set.channels;
+  f.samples = set.samples;
+  f.bounces = set.bounces;
+  f.material_kind = static_cast<std::int64_t>(set.material.kind);
+  f.vertex_count = set.vertex_count;
+  for (int c = 0; c < 3; ++c) f.albedo[c] = set.material.albedo[c];
+  f.specular = set.material.specular;
+  f.exponent = set.material.exponent;
+  f.roughness = set.material.roughness;
+  f.f0 = set.material.f0;
+  return f;
+}
+
+// lo <= v <= hi, false for NaN.
+bool within(float v, float lo, float hi) {
+  return v >= lo && v <= hi;
+}
+
+// The first field out of range, as "<field> <value> <what is allowed>", or "" when all are
+// in range. Material parameters are checked for the model that uses them (Material's own
+// ranges); unused ones only need to be finite.
+std::string field_problem(const Fields& f) {
+  const auto out = [](const char* name, std::int64_t v, const char* allowed) {
+    return std::string(name) + " " + std::to_string(v) + " out of range (" + allowed + ")";
+  };
+  if (f.kind < 0 || f.kind > 1) return out("transfer kind", f.kind, "0 diffuse, 1 glossy");
+  if (f.order < 1 || f.order > kMaxOrder) return out("SH order", f.order, "1 to 10");
+  if (f.channels != 1 && f.channels != 3) return out("channel count", f.channels, "1 or 3");
+  if (f.samples < 1 || f.samples > std::numeric_limits<int>::max())
+    return out("sample count", f.samples, "at least 1");
+  if (f.bounces < 0 || f.bounces > kMaxBounces) return out("bounce count", f.bounces, "0 to 16");
+  if (f.material_kind < 0 || f.material_kind > 2)
+    return out("material kind", f.material_kind, "0 lambert, 1 phong, 2 cook-torrance");
+  if (f.vertex_count > kMaxVertexCount) {
+    return "vertex count " + std::to_string(f.vertex_count) + " out of range (at most 2^40)";
+  }
+
+  const auto bad = [](const std::string& name, float v, const char* allowed) {
+    return "material " + name + " " + num(v) + " out of range (" + allowed + ")";
+  };
+  const auto kind = static_cast<MaterialKind>(f.material_kind);
+  const bool specular_lobe = kind != MaterialKind::kLambert;
+  for (int c = 0; c < 3; ++c) {
+    if (!within(f.albedo[c], 0.f, 1.f))
+      return bad("albedo[" + std::to_string(c) + "]", f.albedo[c], "0 to 1");
+  }
+  if (!std::isfinite(f.specular) || (specular_lobe && !within(f.specular, 0.f, 1.f)))
+    return bad("specular", f.specular, "0 to 1");
+  if (!std::isfinite(f.exponent) ||
+      (kind == MaterialKind::kPhong && !within(f.exponent, 0.f, kMaxExponent)))
+    return bad("exponent", f.exponent, "0 to 10000");
+  if (!std::isfinite(f.roughness) ||
+      (kind == MaterialKind::kCookTorrance && !(f.roughness > 0.f && f.roughness <= 1.f)))
+    return bad("roughness", f.roughness, "above 0, at most 1");
+  if (!std::isfinite(f.f0) || (kind == MaterialKind::kCookTorrance && !within(f.f0, 0.f, 1.f)))
+    return bad("f0", f.f0, "0 to 1");
+  return {};
+}
+
+// vertex_count x floats_per_vertex, or false on overflow.
+bool payload_floats_of(std::uint64_t vertex_count, std::uint64_t floats_per_vertex,
+                       std::uint64_t* out) {
+  return !__builtin_mul_overflow(vertex_count, floats_per_vertex, out);
+}
+
+// "vertex V, channel C, entry (i, j)" of a flat payload index.
+std::string locate(const TransferSet& set, std::size_t index) {
+  const std::size_t per_vertex = set.floats_per_vertex();
+  const std::size_t per_channel = set.floats_per_channel();
+  const std::size_t cols = static_cast<std::size_t>(set.columns());
+  const std::size_t in_channel = index % per_vertex % per_channel;
+  return "vertex " + std::to_string(index / per_vertex) + ", channel " +
+         std::to_string(index % per_vertex / per_channel) + ", entry (" +
+         std::to_string(in_channel / cols) + ", " + std::to_string(in_channel % cols) + ")";
+}
+
+// Index of the first NaN or Inf, or data.size() when all are finite.
+std::size_t first_non_finite(const std::vector<float>& data) {
+  for (std::size_t i = 0; i < data.size(); ++i)
+    if (!std::isfinite(data[i])) return i;
+  return data.size();
+}
+
+Header encode_header(const TransferSet& set, std::uint64_t payload_checksum) {
+  Header h{};  // zero: padding and reserved fields
+  std::memcpy(h.data() + kOffMagic, kMagic.data(), kMagic.size());
+  put<std::uint32_t>(h, kOffVersion, kTransferFileVersion);
+  put<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
+  put<std::uint32_t>(h, kOffKind, static_cast<std::uint32_t>(set.kind));
+  put<std::uint32_t>(h, kOffOrder, static_cast<std::uint32_t>(set.order));
+  put<std::uint32_t>(h, kOffChannels, static_cast<std::uint32_t>(set.channels));
+  put<std::uint32_t>(h, kOffSamples, static_cast<std::uint32_t>(set.samples));
+  put<std::uint32_t>(h, kOffBounces, static_cast<std::uint32_t>(set.bounces));
+  put<std::uint32_t>(h, kOffMaterialKind, static_cast<std::uint32_t>(set.material.kind));
+  put<std::uint64_t>(h, kOffVertexCount, set.vertex_count);
+  put<std::uint64_t>(h, kOffSeed, set.seed);
+  put<std::uint64_t>(h, kOffMeshHash, set.mesh_hash);
+  for (int c = 0; c < 3; ++c) put<float>(h, kOffAlbedo + 4 * c, set.material.albedo[c]);
+  put<float>(h, kOffSpecular, set.material.specular);
+  put<float>(h, kOffExponent, set.material.exponent);
+  put<float>(h, kOffRoughness, set.material.roughness);
+  put<float>(h, kOffF0, set.material.f0);
+  put<std::uint64_t>(h, kOffPayloadFloats, set.data.size());
+  put<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum);
+  put<std::uint64_t>(h, kOffHeaderChecksum, common::fnv1a(h.data(), kOffHeaderChecksum));
+  return h;
+}
+
+std::string printable(const char* bytes, std::size_t n) {
+  std::string s;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
+      s += static_cast<char>(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      s += buf;
+    }
+  }
+  return s;
+}
+
+TransferSet read(const fs::path& path, bool with_payload) {
+  const std::string name = path.string();
+  const auto fail = [&](const std::string& problem) {
+    return TransferFileError(name + ": " + problem);
+  };
+
+  // File-system problems first, each with its own fix.
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) {
+    throw fail("cannot be inspected (" + ec.message() + "); check the path and permissions");
+  }
+  if (!fs::exists(status)) {
+    throw fail("no such transfer file; check the path, or create it with prtr bake");
+  }
+  if (fs::is_directory(status)) {
+    throw fail("is a directory, not a transfer file; name the .prtx file written by prtr bake");
+  }
+  if (!fs::is_regular_file(status)) {
+    throw fail("is not a regular file; name the .prtx file written by prtr bake");
+  }
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw fail("cannot be opened for reading; check its permissions");
+
+  const auto truncated_header = [&](std::uintmax_t found) {
+    return fail("truncated header: the file has " + std::to_string(found) +
+                " bytes, a transfer file at least " + std::to_string(kHeaderBytes) + "; " +
+                kRebake);
+  };
+  if (size < kHeaderBytes) throw truncated_header(size);
+  Header h;
+  in.read(reinterpret_cast<char*>(h.data()), kHeaderBytes);
+  if (std::size_t(in.gcount()) != kHeaderBytes) throw truncated_header(std::size_t(in.gcount()));
+
+  // Identity and version before any field is trusted.
+  if (std::memcmp(h.data() + kOffMagic, kMagic.data(), kMagic.size()) != 0) {
+    throw fail("not a prtr transfer file (it starts with \"" +
+               printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
+               "\", not \"PRTRXFER\"); name a .prtx file written by prtr bake");
+  }
+  const auto version = get<std::uint32_t>(h, kOffVersion);
+  if (version != kTransferFileVersion) {
+    const std::string which = version > kTransferFileVersion ? "a newer" : "an older";
+    throw fail("written by " + which + " prtr version (file format version " +
+               std::to_string(version) + "; this prtr reads version " +
+               std::to_string(kTransferFileVersion) + "); " +
+               (version > kTransferFileVersion ? "use that prtr, or " : "") + kRebake +
+               " from this version");
+  }
+  const auto header_bytes = get<std::uint32_t>(h, kOffHeaderBytes);
+  if (header_bytes != kHeaderBytes) {
+    throw fail("header size " + std::to_string(header_bytes) + " bytes, version 1 has " +
+               std::to_string(kHeaderBytes) + "; the header is damaged: " + kRebake);
+  }
+
+  Fields f;
+  f.kind = get<std::uint32_t>(h, kOffKind);
+  f.order = get<std::uint32_t>(h, kOffOrder);
+  f.channels = get<std::uint32_t>(h, kOffChannels);
+  f.samples = get<std::uint32_t>(h, kOffSamples);
+  f.bounces = get<std::uint32_t>(h, kOffBounces);
+  f.material_kind = get<std::uint32_t>(h, kOffMaterialKind);
+  f.vertex_count = get<std::uint64_t>(h, kOffVertexCount);
+  for (int c = 0; c < 3; ++c) f.albedo[c] = get<float>(h, kOffAlbedo + 4 * c);
+  f.specular = get<float>(h, kOffSpecular);
+  f.exponent = get<float>(h, kOffExponent);
+  f.roughness = get<float>(h, kOffRoughness);
+  f.f0 = get<float>(h, kOffF0);
+  if (const std::string problem = field_problem(f); !problem.empty()) {
+    throw fail(problem + " in the header; the file is damaged: " + kRebake);
+  }
+  if (get<std::uint32_t>(h, kOffReserved0) != 0 || get<std::uint64_t>(h, kOffReserved1) != 0) {
+    throw fail("reserved header bytes are not zero; the file is damaged: " + std::string(kRebake));
+  }
+
+  TransferSet set;
+  set.kind = static_cast<TransferKind>(f.kind);
+  set.order = static_cast<int>(f.order);
+  set.channels = static_cast<int>(f.channels);
+  set.samples = static_cast<int>(f.samples);
+  set.bounces = static_cast<int>(f.bounces);
+  set.vertex_count = f.vertex_count;
+  set.seed = get<std::uint64_t>(h, kOffSeed);
+  set.mesh_hash = get<std::uint64_t>(h, kOffMeshHash);
+  set.material.kind = static_cast<MaterialKind>(f.material_kind);
+  set.material.albedo = Eigen::Vector3f(f.albedo[0], f.albedo[1], f.albedo[2]);
+  set.material.specular = f.specular;
+  set.material.exponent = f.exponent;
+  set.material.roughness = f.roughness;
+  set.material.f0 = f.f0;
+
+  // Sizes: vertex_count <= 2^40 and floats_per_vertex <= 3 * 100 * 100, so the product fits
+  // in 64 bits; the checks stay in case either limit grows.
+  const std::uint64_t payload_floats = get<std::uint64_t>(h, kOffPayloadFloats);
+  std::uint64_t expected_floats = 0;
+  if (!payload_floats_of(set.vertex_count, set.floats_per_vertex(), &expected_floats) ||
+      payload_floats != expected_floats) {
+    throw fail("payload size mismatch: the header says " + std::to_string(payload_floats) +
+               " floats, but " + std::to_string(set.vertex_count) + " vertices x " +
+               std::to_string(set.floats_per_vertex()) + " floats per vertex is " +
+               std::to_string(expected_floats) + "; the header is damaged: " + kRebake);
+  }
+  const auto header_checksum = common::fnv1a(h.data(), kOffHeaderChecksum);
+  if (header_checksum != get<std::uint64_t>(h, kOffHeaderChecksum)) {
+    throw fail("header damaged (checksum " + hex(header_checksum) + ", the header records " +
+               hex(get<std::uint64_t>(h, kOffHeaderChecksum)) + "); " + kRebake);
+  }
+  std::uint64_t expected_size = 0;
+  if (__builtin_mul_overflow(payload_floats, std::uint64_t(4), &expected_size) ||
+      __builtin_add_overflow(expected_size, std::uint64_t(kHeaderBytes), &expected_size)) {
+    throw fail("payload of " + std::to_string(payload_floats) +
+               " floats is too large for any file; the header is damaged: " + kRebake);
+  }
+  const auto size_problem = [&](std::uintmax_t found) {
+    if (found < expected_size) {
+      return fail("truncated: expected " + std::to_string(expected_size) + " bytes, found " +
+                  std::to_string(found) +
+                  " (the write or copy was interrupted); copy it again or " + kRebake);
+    }
+    return fail("trailing bytes: expected " + std::to_string(expected_size) + " bytes, found " +
+                std::to_string(found) + " (" + std::to_string(found - expected_size) +
+                " extra); the file is damaged: " + kRebake);
+  };
+  if (size != expected_size) throw size_problem(size);
+  if (!with_payload) return set;
+
+  // One read straight into the vector; the file size was checked above, so a short read
+  // means the file changed under us.
+  set.data.resize(payload_floats);
+  const std::size_t payload_bytes = payload_floats * sizeof(float);
+  in.read(reinterpret_cast<char*>(set.data.data()), std::streamsize(payload_bytes));
+  if (std::size_t(in.gcount()) != payload_bytes) {
+    throw size_problem(kHeaderBytes + std::size_t(in.gcount()));
+  }
+  const auto payload_checksum = common::fnv1a(set.data.data(), payload_bytes);
+  if (payload_checksum != get<std::uint64_t>(h, kOffPayloadChecksum)) {
+    throw fail("payload damaged (checksum " + hex(payload_checksum) + ", the header records " +
+               hex(get<std::uint64_t>(h, kOffPayloadChecksum)) + "); " + kRebake);
+  }
+  if (const std::size_t i = first_non_finite(set.data); i != set.data.size()) {
+    throw fail("non-finite value " + num(set.data[i]) + " at " + locate(set, i) +
+               "; the file is damaged: " + kRebake);
+  }
+  return set;
+}
+
+}  // namespace
+
+void write_transfer(const fs::path& path, const TransferSet& set) {
+  const auto refuse = [&](const std::string& problem) {
+    return std::invalid_argument(path.string() + ": cannot write the transfer set: " + problem);
+  };
+  // Refuse what read_transfer would refuse, so that every written file can be read back.
+  if (const std::string problem = field_problem(fields_of(set)); !problem.empty())
+    throw refuse(problem);
+  std::uint64_t expected_floats = 0;
+  if (!payload_floats_of(set.vertex_count, set.floats_per_vertex(), &expected_floats) ||
+      set.data.size() != expected_floats) {
+    throw refuse("data holds " + std::to_string(set.data.size()) + " floats, but " +
+                 std::to_string(set.vertex_count) + " vertices x " +
+                 std::to_string(set.floats_per_vertex()) + " floats per vertex is " +
+                 std::to_string(expected_floats));
+  }
+  if (const std::size_t i = first_non_finite(set.data); i != set.data.size())
+    throw refuse("non-finite value " + num(set.data[i]) + " at " + locate(set, i));
+
+  const std::size_t payload_bytes = set.data.size() * sizeof(float);
+  const Header h = encode_header(set, common::fnv1a(set.data.data(), payload_bytes));
+  common::AtomicFile file(path);
+  file.write(h.data(), h.size());
+  if (payload_bytes > 0) file.write(set.data.data(), payload_bytes);
+  file.commit();
+}
+
+TransferSet read_transfer(const fs::path& path) {
+  return read(path, true);
+}
+
+TransferSet read_transfer_header(const fs::path& path) {
+  return read(path, false);
+}
+
+}  // namespace prt
