@@ -10,7 +10,9 @@
 namespace common {
 namespace {
 
-std::string errno_text() { return std::strerror(errno); }
+std::string errno_text() {
+  return std::strerror(errno);
+}
 
 }  // namespace
 
@@ -25,14 +27,20 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
   // A unique name in the same directory, so the final rename stays on one file system.
   std::random_device rd;
   for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
-    temp_ = dir / ("." + target_.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                   "-" + std::to_string(rd() & 0xffffff));
+    // Built with append: GCC 12 reports a false -Wrestrict on chained operator+ here.
+    std::string name = ".";
+    name.append(target_.filename().string())
+        .append(".tmp-")
+        .append(std::to_string(::getpid()))
+        .append("-")
+        .append(std::to_string(rd() & 0xffffff));
+    temp_ = dir / name;
     fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd_ < 0 && errno != EEXIST) break;
   }
   if (fd_ < 0) {
-    throw IoError(target_.string() + ": cannot create a temporary file in " + dir.string() +
-                  " (" + errno_text() + ")");
+    throw IoError(target_.string() + ": cannot create a temporary file in " + dir.string() + " (" +
+                  errno_text() + ")");
   }
 }
 

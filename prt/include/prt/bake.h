@@ -1,0 +1,84 @@
+// prt/bake.h: per-vertex SH transfer by ray tracing (Embree): a shadow pass, then
+// interreflection passes. Thesis ch. 3.1.1 (eq. 1-3) and DESIGN.md "The math".
+//
+// Method. Every vertex uses the same hemisphere direction set D (prt/sampling.h) expressed
+// in its local frame F_p = [t b n], so the SH values Y (n x S) of those directions are
+// computed once for the whole mesh; only visibility differs between vertices. With w the
+// quadrature weight and O_p the occluded subset:
+//  - shadow pass (local frame):  T_p = w sum_{s visible} y(s) y(s)^T
+//                                    = w Y Y^T - w Y_O Y_O^T,
+//    so a vertex costs work in proportion to its occluded rays (a symmetric rank-k update);
+//  - glossy exit transfer:       M_p = B T_p D(F_p^T)   (B: prt/material.h; D: sh_rotation.h)
+//    which equals DESIGN.md's B D(F_p^T) T_p(world) with T_p expressed in the local frame;
+//  - diffuse transfer:           t_p = D(F_p) (rho/pi) w sum_{s visible} s_z y(s);
+//  - bounce b >= 1: an occluded ray that hits the front of triangle (q0, q1, q2) at
+//    barycentrics (u, v) brings r = sum_c beta_c y(F_c^T (-s))^T M_c^{b-1} (glossy) or
+//    sum_c beta_c t_c^{b-1} (diffuse), the radiance the hit point sends back along -s;
+//    T_p^b = w sum_{s occluded} y(s_local) r, M_p^b = B T_p^b; t_p^b = (rho/pi) w sum s_z r.
+//    Back-face hits occlude but bring nothing. The result is sum_b M_p^b.
+// Vertices are independent, so the output is bit-identical for any thread count.
+//
+// Rays start at p + offset o_p (offset relative to the bounding-box diagonal), where o_p is
+// the normalised sum of the normals of all triangles at p's position, across split vertices:
+// the vertex normal on a welded mesh, the bisector at a hard edge made of split vertices.
+// That clears the vertex's own triangles and any other face through p, and stays far below
+// the thickness of thin parts.
+#pragma once
+
+#include "meshes/mesh.h"
+#include "prt/material.h"
+#include "prt/transfer.h"
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace prt {
+
+struct BakeProgress {
+  int pass = 0;                       // 0 = shadow pass, b = bounce b
+  int passes = 1;                     // 1 + bounces
+  std::uint64_t done = 0, total = 0;  // vertices finished in this pass
+};
+
+struct BakeOptions {
+  TransferKind kind = TransferKind::kGlossy;
+  int order = 6;
+  int samples = 1024;  // hemisphere directions per vertex
+  int bounces = 1;
+  std::uint64_t seed = 1;
+  Material material;
+  double ray_offset = 1e-4;  // times the bounding-box diagonal
+  // Glossy only: use this n x n matrix for every channel instead of the material's BRDF
+  // matrix (a measured BRDF projected elsewhere; tests pass the identity to read T_p).
+  // The file still records `material`.
+  std::optional<Eigen::MatrixXd> brdf_override;
+  // Called from worker threads, never concurrently with itself, at most every ~50 ms.
+  std::function<void(const BakeProgress&)> progress;
+};
+
+// Throws std::invalid_argument naming the option (as its CLI flag) when out of range.
+void validate(const BakeOptions& options);
+
+struct BakeEstimate {
+  std::uint64_t bytes = 0;  // peak memory of the bake's buffers
+  std::uint64_t rays = 0;   // shadow-pass rays (bounces re-trace only the occluded ones)
+  std::uint64_t output_bytes = 0;
+};
+BakeEstimate estimate_bake(const meshes::Mesh& mesh, const BakeOptions& options);
+
+// Bytes of memory available now (MemAvailable in /proc/meminfo), 0 if unknown.
+std::uint64_t available_memory();
+
+struct BakeStats {
+  double seconds_shadow = 0, seconds_bounces = 0, seconds_brdf = 0, seconds_total = 0;
+  std::uint64_t rays_shadow = 0, rays_bounce = 0;
+  double occluded_fraction = 0;
+};
+
+// The mesh must have frames (meshes::compute_frames). Throws std::invalid_argument for bad
+// options and RayError if Embree fails.
+TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& options, BakeStats* stats = nullptr);
+
+}  // namespace prt
