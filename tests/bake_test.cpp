@@ -8,6 +8,7 @@
 #include "prt/sh.h"
 #include "prt/sh_rotation.h"
 #include "prt/zonal.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -100,22 +101,11 @@ Eigen::MatrixXd hemisphere_product(int order) {
   const int nz = 32, nphi = 64, n = prt::sh_count(order);
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(n, n);
   std::vector<double> y(n);
+  std::vector<double> gx, gw;
+  test_support::gauss_legendre(nz, gx, gw);
   for (int i = 0; i < nz; ++i) {
-    // Gauss-Legendre node on [-1, 1] by Newton, mapped to (0, 1).
-    double x = std::cos(kPi * (i + 0.75) / (nz + 0.5)), dp = 0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = x;
-      for (int k = 2; k <= nz; ++k) {
-        const double p2 = ((2.0 * k - 1) * x * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = nz * (x * p1 - p0) / (x * x - 1);
-      const double dx = p1 / dp;
-      x -= dx;
-      if (std::abs(dx) < 1e-16) break;
-    }
-    const double w = 2 / ((1 - x * x) * dp * dp) * 0.5, z = 0.5 * (x + 1), r = std::sqrt(1 - z * z);
+    // Node mapped from [-1, 1] to (0, 1).
+    const double w = 0.5 * gw[i], z = 0.5 * (gx[i] + 1), r = std::sqrt(1 - z * z);
     for (int k = 0; k < nphi; ++k) {
       const double phi = 2 * kPi * (k + 0.5) / nphi;
       prt::sh_eval(order, Vec3d(r * std::cos(phi), r * std::sin(phi), z), y.data());

@@ -1,6 +1,8 @@
 #include "common/atomic_file.h"
 #include "common/hash.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -12,17 +14,9 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(PRTR_TEST_TMPDIR) / "common";
-  fs::create_directories(dir);
-  return dir / name;
+  return test_support::scratch("common", name);
 }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test_support::slurp;
 
 int files_in(const fs::path& dir) {
   int n = 0;

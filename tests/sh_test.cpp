@@ -2,6 +2,7 @@
 // and the sign/axis conventions written in prt/sh.h.
 #include "prt/sh.h"
 #include "prt/sampling.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -11,29 +12,7 @@
 
 namespace {
 
-// Gauss-Legendre nodes/weights on [-1, 1] by Newton iteration on P_n.
-void gauss_legendre(int n, std::vector<double>& x, std::vector<double>& w) {
-  x.resize(n);
-  w.resize(n);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5));
-    double dp = 0.0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1.0, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1.0);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::abs(dz) < 1e-15) break;
-    }
-    x[i] = z;
-    w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
-  }
-}
+using test_support::gauss_legendre;
 
 TEST(Sh, IndexAndBand) {
   EXPECT_EQ(prt::sh_count(6), 36);

@@ -5,6 +5,8 @@
 #include "common/atomic_file.h"
 #include "common/hash.h"
 
+#include "test_support.h"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -49,17 +51,9 @@ constexpr std::size_t kOffHeaderChecksum = 120;
 constexpr std::size_t kPayloadOffset = 128;
 
 fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(PRTR_TEST_TMPDIR) / "transfer_file";
-  fs::create_directories(dir);
-  return dir / name;
+  return test_support::scratch("transfer_file", name);
 }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test_support::slurp;
 
 template <class T>
 T peek(const std::string& bytes, std::size_t offset) {

@@ -18,6 +18,29 @@ void on_embree_error(void* user, RTCError code, const char* message) {
   *last = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
 }
 
+// Fills a 16-wide packet with rays start .. start+width-1 from one origin; lanes past
+// `width` repeat the last ray and are masked off in `valid`.
+void fill_packet(RTCRay16& rays, int* valid, const Eigen::Vector3f& origin,
+                 const Eigen::Ref<const Eigen::Matrix3Xf>& directions, Eigen::Index start,
+                 int width, float tnear) {
+  for (int k = 0; k < kPacket; ++k) {
+    const Eigen::Index col = start + std::min(k, width - 1);
+    valid[k] = k < width ? -1 : 0;
+    rays.org_x[k] = origin.x();
+    rays.org_y[k] = origin.y();
+    rays.org_z[k] = origin.z();
+    rays.tnear[k] = tnear;
+    rays.dir_x[k] = directions(0, col);
+    rays.dir_y[k] = directions(1, col);
+    rays.dir_z[k] = directions(2, col);
+    rays.time[k] = 0.f;
+    rays.tfar[k] = std::numeric_limits<float>::infinity();
+    rays.mask[k] = 0xffffffffu;
+    rays.id[k] = unsigned(k);
+    rays.flags[k] = 0;
+  }
+}
+
 }  // namespace
 
 struct RayScene::Impl {
@@ -82,22 +105,7 @@ void RayScene::occluded(const Eigen::Vector3f& origin,
   const Eigen::Index count = directions.cols();
   for (Eigen::Index start = 0; start < count; start += kPacket) {
     const int width = int(std::min<Eigen::Index>(kPacket, count - start));
-    for (int k = 0; k < kPacket; ++k) {
-      const Eigen::Index col = start + std::min(k, width - 1);
-      valid[k] = k < width ? -1 : 0;
-      rays.dir_x[k] = directions(0, col);
-      rays.dir_y[k] = directions(1, col);
-      rays.dir_z[k] = directions(2, col);
-      rays.org_x[k] = origin.x();
-      rays.org_y[k] = origin.y();
-      rays.org_z[k] = origin.z();
-      rays.tnear[k] = tnear;
-      rays.time[k] = 0.f;
-      rays.tfar[k] = std::numeric_limits<float>::infinity();
-      rays.mask[k] = 0xffffffffu;
-      rays.id[k] = unsigned(k);
-      rays.flags[k] = 0;
-    }
+    fill_packet(rays, valid, origin, directions, start, width, tnear);
     rtcOccluded16(valid, impl_->scene, &context, &rays);
     // Embree marks an occluded ray by setting tfar to -inf.
     for (int k = 0; k < width; ++k) occluded[start + k] = rays.tfar[k] < 0.f ? 1 : 0;
@@ -115,21 +123,8 @@ void RayScene::intersect(const Eigen::Vector3f& origin,
   const Eigen::Index count = directions.cols();
   for (Eigen::Index start = 0; start < count; start += kPacket) {
     const int width = int(std::min<Eigen::Index>(kPacket, count - start));
+    fill_packet(rh.ray, valid, origin, directions, start, width, tnear);
     for (int k = 0; k < kPacket; ++k) {
-      const Eigen::Index col = start + std::min(k, width - 1);
-      valid[k] = k < width ? -1 : 0;
-      rh.ray.dir_x[k] = directions(0, col);
-      rh.ray.dir_y[k] = directions(1, col);
-      rh.ray.dir_z[k] = directions(2, col);
-      rh.ray.org_x[k] = origin.x();
-      rh.ray.org_y[k] = origin.y();
-      rh.ray.org_z[k] = origin.z();
-      rh.ray.tnear[k] = tnear;
-      rh.ray.time[k] = 0.f;
-      rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
-      rh.ray.mask[k] = 0xffffffffu;
-      rh.ray.id[k] = unsigned(k);
-      rh.ray.flags[k] = 0;
       rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
       rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
     }
