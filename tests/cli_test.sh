@@ -40,6 +40,42 @@ run mesh "$tmp/quad.obj"; expect_code 0; check "quad loads" $?
 [[ $out =~ \(1\ polygons\ triangulated\) ]]; check "quad: 1 polygon triangulated" $?
 [[ $out =~ area\ +1($|[^0-9]) ]]; check "quad: area 1" $?
 
+# Bake: a closed cube (inward-facing faces would also work; any mesh does).
+cat >"$tmp/cube.obj" <<'OBJ'
+v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+OBJ
+run bake "$tmp/cube.obj" -o "$tmp/cube.prtx" --order 3 --samples 64 --bounces 1 --quiet
+expect_code 0; check "bake exits 0" $?
+[[ $(head -c 8 "$tmp/cube.prtx" 2>/dev/null) == PRTRXFER ]]; check "bake writes a .prtx file" $?
+size=$(stat -c %s "$tmp/cube.prtx" 2>/dev/null || echo 0)
+((size == 128 + 8 * 81 * 4)); check "bake file size: header + 8 vertices x 81 floats ($size)" $?
+[[ $out =~ rays\ +[0-9.]+\ M ]]; check "bake reports rays" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --order 11; expect_code 2; check "bake --order 11 is a usage error" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --material lambert --exponent 8
+expect_code 2 && [[ $err == *--exponent* ]]; check "bake: --exponent with lambert is a usage error" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --albedo 0.5,0.5; expect_code 2; check "bake: --albedo with two values is a usage error" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --albedo 0.9 --specular 0.5
+expect_code 2 && [[ $err == *--specular* || $err == *--albedo* ]]; check "bake: albedo + specular > 1 is a usage error" $?
+run bake "$tmp/missing.obj" -o "$tmp/x.prtx"; expect_code 1 && [[ $err == *missing.obj* ]]; check "bake: missing mesh exits 1 naming it" $?
+run bake "$tmp/cube.obj" -o "$tmp/no/such/dir/x.prtx" --order 2 --samples 16 --quiet
+expect_code 1 && [[ $err == *x.prtx* ]]; check "bake: missing output directory exits 1 naming it" $?
+leftovers=$(find "$tmp" -name '*.tmp-*' | wc -l)
+((leftovers == 0)); check "bake leaves no temporary files ($leftovers)" $?
+[[ ! -e $tmp/x.prtx ]]; check "failed bakes leave no output" $?
+
 # The real inputs, when installed.
 bunny=/usr/share/glmark2/models/bunny.obj
 if [[ -f $bunny ]]; then
