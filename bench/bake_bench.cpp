@@ -1,17 +1,19 @@
 // Bake throughput against the machine's limit: the bare Embree occlusion queries for
 // exactly the rays the shadow pass traces (same mesh, frames, direction set, offsets), in
-// the same run. Usage: bake_bench [MESH] [SAMPLES]
+// the same run. Usage: bake_bench [MESH] [SAMPLES] [THREADS]
 #include "meshes/load.h"
 #include "prt/bake.h"
 #include "prt/ray_scene.h"
 #include "prt/sampling.h"
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,12 @@ double now_seconds() {
 int main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : "/usr/share/glmark2/models/bunny.obj";
   const int samples = argc > 2 ? std::atoi(argv[2]) : 1024;
+  const int threads = argc > 3 ? std::atoi(argv[3]) : 0;  // 0: all cores
+  std::unique_ptr<tbb::global_control> limit;
+  if (threads > 0) {
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  threads);
+  }
   const meshes::Mesh mesh = meshes::load_mesh(path);
   const prt::RayScene scene(mesh);
   const prt::DirectionSet set = prt::hemisphere_directions(samples, 1);

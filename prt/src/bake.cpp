@@ -378,10 +378,10 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
 
     struct BounceScratch {
       Eigen::Matrix3Xf corner_dirs;
-      ShBatchF corner_y;
-      MatF y_hit, rows, transfer;
-      std::vector<std::pair<std::uint32_t, int>> pairs;  // (corner vertex, 3 * hit + corner)
-      RowMatF gathered, products;
+      ShBatchF corner_batch;
+      MatF corner_y;
+      MatF y_hit, transfer;
+      RowMatF rows;  // row h is updated per hit: keep it contiguous
     };
     tbb::enumerable_thread_specific<BounceScratch> bounce_pool([&] {
       BounceScratch b;
@@ -389,9 +389,6 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
       b.y_hit.resize(n, samples);
       b.rows.resize(samples, n);
       b.transfer.resize(n, n);
-      b.pairs.reserve(3 * std::size_t(samples));
-      b.gathered.resize(3 * samples, n);
-      b.products.resize(3 * samples, n);
       return b;
     });
 
@@ -421,43 +418,23 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
                     mesh.bitangents[q].dot(back), mesh.normals[q].dot(back);
               }
             }
-            sh_eval_batch(o.order, s.corner_dirs.leftCols(3 * count), s.corner_y);
+            sh_eval_batch(o.order, s.corner_dirs.leftCols(3 * count), s.corner_batch);
+            s.corner_y = s.corner_batch;  // column-major: each corner's values contiguous
           }
           for (int h = 0; h < count; ++h) s.y_hit.col(h) = setup.y.col(hits[h].direction);
 
-          if (glossy) {
-            // Group the (corner, hit) pairs by corner vertex so each corner's matrix is read
-            // once per vertex and multiplied as a small GEMM: reading a 36 x 36 matrix per
-            // pair made this pass memory-bound.
-            s.pairs.clear();
-            for (int h = 0; h < count; ++h) {
-              const meshes::Triangle& tri = mesh.triangles[hits[h].triangle];
-              for (int c = 0; c < 3; ++c) s.pairs.push_back({tri[c], 3 * h + c});
-            }
-            std::sort(s.pairs.begin(), s.pairs.end());
-          }
           for (int ch = 0; ch < channels; ++ch) {
             // rows.row(h): radiance the hit point sends toward p, as a function of lighting.
             s.rows.topRows(count).setZero();
             if (glossy) {
-              for (std::size_t g = 0; g < s.pairs.size();) {
-                std::size_t e = g;
-                while (e < s.pairs.size() && s.pairs[e].first == s.pairs[g].first) ++e;
-                const int k = int(e - g);
-                for (int j = 0; j < k; ++j) {
-                  s.gathered.row(j) = s.corner_y.col(s.pairs[g + j].second).transpose();
+              for (int h = 0; h < count; ++h) {
+                const meshes::Triangle& tri = mesh.triangles[hits[h].triangle];
+                const float beta[3] = {1.f - hits[h].u - hits[h].v, hits[h].u, hits[h].v};
+                for (int c = 0; c < 3; ++c) {
+                  const float* src = previous.data() + tri[c] * per_vertex + ch * per_channel;
+                  s.rows.row(h).noalias() += beta[c] * (s.corner_y.col(3 * h + c).transpose() *
+                                                        Eigen::Map<const RowMatF>(src, n, n));
                 }
-                const float* src =
-                    previous.data() + s.pairs[g].first * per_vertex + ch * per_channel;
-                s.products.topRows(k).noalias() =
-                    s.gathered.topRows(k) * Eigen::Map<const RowMatF>(src, n, n);
-                for (int j = 0; j < k; ++j) {
-                  const int pair = s.pairs[g + j].second, h = pair / 3, c = pair % 3;
-                  const float beta =
-                      c == 0 ? 1.f - hits[h].u - hits[h].v : (c == 1 ? hits[h].u : hits[h].v);
-                  s.rows.row(h) += beta * s.products.row(j);
-                }
-                g = e;
               }
             } else {
               for (int h = 0; h < count; ++h) {

@@ -1,5 +1,4 @@
-// The only file that includes Embree. Rays go in 16-wide packets (RTCRay16, structure of
-// arrays), flagged coherent: all rays of a packet share their origin.
+// The only file that includes Embree.
 #include "prt/ray_scene.h"
 
 #include <embree3/rtcore.h>
@@ -7,38 +6,38 @@
 #include <algorithm>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace prt {
 namespace {
-
-constexpr int kPacket = 16;
 
 void on_embree_error(void* user, RTCError code, const char* message) {
   auto* last = static_cast<std::string*>(user);
   *last = "Embree error " + std::to_string(int(code)) + ": " + (message ? message : "");
 }
 
-// Fills a 16-wide packet with rays start .. start+width-1 from one origin; lanes past
-// `width` repeat the last ray and are masked off in `valid`.
-void fill_packet(RTCRay16& rays, int* valid, const Eigen::Vector3f& origin,
-                 const Eigen::Ref<const Eigen::Matrix3Xf>& directions, Eigen::Index start,
-                 int width, float tnear) {
-  for (int k = 0; k < kPacket; ++k) {
-    const Eigen::Index col = start + std::min(k, width - 1);
-    valid[k] = k < width ? -1 : 0;
-    rays.org_x[k] = origin.x();
-    rays.org_y[k] = origin.y();
-    rays.org_z[k] = origin.z();
-    rays.tnear[k] = tnear;
-    rays.dir_x[k] = directions(0, col);
-    rays.dir_y[k] = directions(1, col);
-    rays.dir_z[k] = directions(2, col);
-    rays.time[k] = 0.f;
-    rays.tfar[k] = std::numeric_limits<float>::infinity();
-    rays.mask[k] = 0xffffffffu;
-    rays.id[k] = unsigned(k);
-    rays.flags[k] = 0;
-  }
+// Fills stream[k] with the ray origin + t d_k, t in [tnear, inf).
+void fill_ray(RTCRay& r, const Eigen::Vector3f& origin,
+              const Eigen::Ref<const Eigen::Matrix3Xf>& directions, Eigen::Index k, float tnear) {
+  r.org_x = origin.x();
+  r.org_y = origin.y();
+  r.org_z = origin.z();
+  r.tnear = tnear;
+  r.dir_x = directions(0, k);
+  r.dir_y = directions(1, k);
+  r.dir_z = directions(2, k);
+  r.time = 0.f;
+  r.tfar = std::numeric_limits<float>::infinity();
+  r.mask = 0xffffffffu;
+  r.id = unsigned(k);
+  r.flags = 0;
+}
+
+RTCIntersectContext incoherent_context() {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  return context;
 }
 
 }  // namespace
@@ -94,51 +93,48 @@ RayScene::RayScene(const meshes::Mesh& mesh) : impl_(std::make_unique<Impl>()) {
 
 RayScene::~RayScene() = default;
 
+// Rays go to Embree as one stream per call (rtcOccluded1M / rtcIntersect1M), flagged
+// incoherent: a vertex's hemisphere rays share an origin but fan out over 2 pi. Measured on
+// the bunny's shadow rays, one thread: stream 7.0 M rays/s, 16-wide packets 5.0, single
+// rays 4.0, either API with the coherent flag 2.8-2.9. Buffers are per thread, reused.
 void RayScene::occluded(const Eigen::Vector3f& origin,
                         const Eigen::Ref<const Eigen::Matrix3Xf>& directions, float tnear,
                         std::uint8_t* occluded) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  RTCRay16 rays;
-  alignas(64) int valid[kPacket];
+  thread_local std::vector<RTCRay> stream;
   const Eigen::Index count = directions.cols();
-  for (Eigen::Index start = 0; start < count; start += kPacket) {
-    const int width = int(std::min<Eigen::Index>(kPacket, count - start));
-    fill_packet(rays, valid, origin, directions, start, width, tnear);
-    rtcOccluded16(valid, impl_->scene, &context, &rays);
-    // Embree marks an occluded ray by setting tfar to -inf.
-    for (int k = 0; k < width; ++k) occluded[start + k] = rays.tfar[k] < 0.f ? 1 : 0;
-  }
+  if (count == 0) return;
+  stream.resize(std::size_t(count));
+  for (Eigen::Index k = 0; k < count; ++k) fill_ray(stream[k], origin, directions, k, tnear);
+  RTCIntersectContext context = incoherent_context();
+  rtcOccluded1M(impl_->scene, &context, stream.data(), unsigned(count), sizeof(RTCRay));
+  // Embree marks an occluded ray by setting tfar to -inf.
+  for (Eigen::Index k = 0; k < count; ++k) occluded[k] = stream[k].tfar < 0.f ? 1 : 0;
 }
 
 void RayScene::intersect(const Eigen::Vector3f& origin,
                          const Eigen::Ref<const Eigen::Matrix3Xf>& directions, float tnear,
                          RayHit* hits) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-  RTCRayHit16 rh;
-  alignas(64) int valid[kPacket];
+  thread_local std::vector<RTCRayHit> stream;
   const Eigen::Index count = directions.cols();
-  for (Eigen::Index start = 0; start < count; start += kPacket) {
-    const int width = int(std::min<Eigen::Index>(kPacket, count - start));
-    fill_packet(rh.ray, valid, origin, directions, start, width, tnear);
-    for (int k = 0; k < kPacket; ++k) {
-      rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
-    }
-    rtcIntersect16(valid, impl_->scene, &context, &rh);
-    for (int k = 0; k < width; ++k) {
-      RayHit& h = hits[start + k];
-      if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) {
-        h = RayHit{};
-      } else {
-        h.triangle = std::int32_t(rh.hit.primID[k]);
-        h.u = rh.hit.u[k];
-        h.v = rh.hit.v[k];
-        h.t = rh.ray.tfar[k];
-      }
+  if (count == 0) return;
+  stream.resize(std::size_t(count));
+  for (Eigen::Index k = 0; k < count; ++k) {
+    fill_ray(stream[k].ray, origin, directions, k, tnear);
+    stream[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    stream[k].hit.primID = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext context = incoherent_context();
+  rtcIntersect1M(impl_->scene, &context, stream.data(), unsigned(count), sizeof(RTCRayHit));
+  for (Eigen::Index k = 0; k < count; ++k) {
+    const RTCRayHit& rh = stream[k];
+    RayHit& h = hits[k];
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+      h = RayHit{};
+    } else {
+      h.triangle = std::int32_t(rh.hit.primID);
+      h.u = rh.hit.u;
+      h.v = rh.hit.v;
+      h.t = rh.ray.tfar;
     }
   }
 }
