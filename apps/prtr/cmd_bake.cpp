@@ -115,10 +115,10 @@ Runner add_bake_command(CLI::App& app) {
     if (!o.quiet) {
       std::fprintf(stderr,
                    "bake: %zu vertices, %s order %d, %d samples, %d bounce(s); about %s "
-                   "of memory, %.1f M shadow rays\n",
+                   "of memory, %.1f M shadow rays, roughly %.0f s\n",
                    mesh.vertex_count(), o.kind.c_str(), o.bake.order, o.bake.samples,
                    o.bake.bounces, format_bytes(estimate.bytes).c_str(),
-                   double(estimate.rays) / 1e6);
+                   double(estimate.rays) / 1e6, estimate.seconds);
     }
 
     ProgressBar bar(o.quiet);

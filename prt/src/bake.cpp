@@ -9,6 +9,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <Eigen/Cholesky>
 
@@ -231,6 +232,11 @@ BakeEstimate estimate_bake(const meshes::Mesh& mesh, const BakeOptions& o) {
   e.bytes = e.output_bytes * buffers +
             (o.bounces > 0 ? v * std::uint64_t(o.samples) * sizeof(HitRecord) : 0);
   e.rays = v * std::uint64_t(o.samples);
+  const double threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  const double n2 = double(sh_count(o.order)) * sh_count(o.order);
+  const double per_ray =
+      1.0 / 4e6 * (o.kind == TransferKind::kGlossy ? std::max(1.0, n2 / 1296) : 1.0);
+  e.seconds = double(e.rays) * per_ray * (1.0 + 1.2 * o.bounces) * shape.channels / threads;
   return e;
 }
 
