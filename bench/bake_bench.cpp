@@ -74,6 +74,34 @@ int main(int argc, char** argv) {
           bare, rays / bare / 1e6, rays / stats.seconds_shadow / 1e6, bare / stats.seconds_shadow);
     }
   }
-  std::printf("occluded fraction %.3f\n", double(occluded_total) / rays);
+  const double occluded_fraction = double(occluded_total) / rays;
+  std::printf("occluded fraction %.3f\n", occluded_fraction);
+
+  // The GEMM rate on this machine: w Y Y^T for one vertex's samples, as the textbook
+  // projection would do it for its visible samples (n = 36, one thread).
+  {
+    const Eigen::MatrixXf y = Eigen::MatrixXf::Random(36, samples);
+    Eigen::MatrixXf t(36, 36);
+    const int reps = 2000;
+    double g0 = now_seconds();
+    for (int r = 0; r < reps; ++r) t.noalias() = y * y.transpose();
+    const double gemm = (now_seconds() - g0) / reps;
+    const double per_sample_gemm = gemm / samples;
+    const double flops = 2.0 * 36 * 36 * samples / gemm;
+    // The baker's shadow-pass work besides the rays, per visible sample.
+    prt::BakeOptions o;
+    o.samples = samples;
+    o.bounces = 0;
+    prt::BakeStats stats;
+    prt::bake(mesh, o, &stats);
+    const double non_ray = std::max(0.0, stats.seconds_shadow - bare);
+    const double visible = rays * (1.0 - occluded_fraction);
+    std::printf("GEMM Y Y^T (36 x %d): %.1f GFLOP/s, %.1f ns per sample\n", samples, flops / 1e9,
+                per_sample_gemm * 1e9);
+    std::printf(
+        "shadow pass besides rays: %.2f s, %.1f ns per visible sample "
+        "(%.2fx the GEMM cost per sample)\n",
+        non_ray, non_ray / visible * 1e9, (non_ray / visible) / per_sample_gemm);
+  }
   return 0;
 }
