@@ -53,6 +53,14 @@ struct BrdfQuadrature {
   int view_theta = 0, view_phi = 0, light_theta = 0, light_phi = 0;
 };
 
+// The grid brdf_matrix uses: the non-zero fields of `quadrature`, and for each zero field the
+// default chosen from the material and order (the rule and its reasons are in material.cpp).
+// Defaults keep light_phi a multiple of view_phi > 2 (order - 1), which makes B commute with
+// rotations about the normal up to rounding; explicit grids should do the same.
+// Throws std::invalid_argument for a negative field or an unsupported order.
+BrdfQuadrature resolve_brdf_quadrature(const Material& material, int order,
+                                       const BrdfQuadrature& quadrature = {});
+
 // n x n BRDF matrix (n = order^2) for one channel, by product quadrature. Cost is dominated
 // by f_r evaluations (view nodes x light nodes) and runs in parallel; a glossy Phong lobe at
 // order 6 takes well under a second.
