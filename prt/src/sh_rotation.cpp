@@ -56,6 +56,39 @@ double w_term(int m, int mp, int l, const Band& r1, const Band& prev) {
   return p_term(1, m - 1, mp, l, r1, prev) - p_term(-1, -m + 1, mp, l, r1, prev);
 }
 
+// The u, v, w coefficients of the recurrence depend only on (l, m, m'), not on R: computed
+// once per band (three square roots per element were ~60% of building D at order 6).
+struct Coefficients {
+  std::vector<Eigen::ArrayXXd> u, v, w;  // per band l >= 2, indexed (m + l, m' + l)
+  Coefficients() : u(kMaxOrder), v(kMaxOrder), w(kMaxOrder) {
+    for (int l = 2; l < kMaxOrder; ++l) {
+      const int size = 2 * l + 1;
+      u[l].resize(size, size);
+      v[l].resize(size, size);
+      w[l].resize(size, size);
+      for (int m = -l; m <= l; ++m) {
+        const int am = std::abs(m);
+        const double d0 = kronecker(m, 0);
+        for (int mp = -l; mp <= l; ++mp) {
+          const double denom =
+              std::abs(mp) < l ? double(l + mp) * double(l - mp) : double(2 * l) * (2 * l - 1);
+          u[l](m + l, mp + l) = std::sqrt(double(l + m) * double(l - m) / denom);
+          v[l](m + l, mp + l) =
+              0.5 * std::sqrt((1.0 + d0) * double(l + am - 1) * double(l + am) / denom) *
+              (1.0 - 2.0 * d0);
+          w[l](m + l, mp + l) =
+              -0.5 * std::sqrt(double(l - am - 1) * double(l - am) / denom) * (1.0 - d0);
+        }
+      }
+    }
+  }
+};
+
+const Coefficients& coefficients() {
+  static const Coefficients c;
+  return c;
+}
+
 }  // namespace
 
 ShRotation::ShRotation(int order, const Eigen::Matrix3d& rotation) : order_(order) {
@@ -83,16 +116,12 @@ ShRotation::ShRotation(int order, const Eigen::Matrix3d& rotation) : order_(orde
     Eigen::MatrixXd& d = bands_[l];
     d.resize(2 * l + 1, 2 * l + 1);
     const Band prev{bands_[l - 1], l - 1};
+    const Coefficients& k = coefficients();
     for (int m = -l; m <= l; ++m) {
-      const int am = std::abs(m);
-      const double d0 = kronecker(m, 0);
       for (int mp = -l; mp <= l; ++mp) {
-        const double denom =
-            std::abs(mp) < l ? double(l + mp) * double(l - mp) : double(2 * l) * (2 * l - 1);
-        const double u = std::sqrt(double(l + m) * double(l - m) / denom);
-        const double v = 0.5 * std::sqrt((1.0 + d0) * double(l + am - 1) * double(l + am) / denom) *
-                         (1.0 - 2.0 * d0);
-        const double w = -0.5 * std::sqrt(double(l - am - 1) * double(l - am) / denom) * (1.0 - d0);
+        const double u = k.u[l](m + l, mp + l);
+        const double v = k.v[l](m + l, mp + l);
+        const double w = k.w[l](m + l, mp + l);
         double value = 0.0;
         if (u != 0.0) value += u * u_term(m, mp, l, b1, prev);
         if (v != 0.0) value += v * v_term(m, mp, l, b1, prev);
