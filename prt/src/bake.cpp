@@ -11,15 +11,12 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include <Eigen/Cholesky>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <fstream>
 #include <mutex>
 #include <numbers>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -71,11 +68,13 @@ Eigen::Matrix3f frame_of(const meshes::Mesh& mesh, std::size_t p) {
 }
 
 // M <- M D (D block diagonal, given as a rotation's bands), i.e. each band's columns.
-void multiply_bands_right(MatF& m, const ShRotation& d, MatF& scratch) {
+// `bands` and `scratch` are caller-owned so a vertex allocates nothing.
+void multiply_bands_right(MatF& m, const ShRotation& d, std::vector<MatF>& bands, MatF& scratch) {
   scratch = m;
   for (int l = 0; l < d.order(); ++l) {
     const int size = 2 * l + 1;
-    m.middleCols(l * l, size).noalias() = scratch.middleCols(l * l, size) * d.band(l).cast<float>();
+    bands[l] = d.band(l).cast<float>();
+    m.middleCols(l * l, size).noalias() = scratch.middleCols(l * l, size) * bands[l];
   }
 }
 
@@ -278,22 +277,30 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
 
   // Per-thread scratch, allocated once per thread and reused for every vertex.
   struct Scratch {
+    explicit Scratch(int order) : rotation(order, Eigen::Matrix3d::Identity()) {}
     Eigen::Matrix3Xf world;
     std::vector<std::uint8_t> occluded;
     std::vector<int> occluded_index;
     MatF y_occluded, transfer, scratch;
+    Eigen::VectorXf diffuse_local;
+    Eigen::VectorXd diffuse_world;
+    ShRotation rotation;  // D of the current vertex's frame, rebuilt in place
+    std::vector<MatF> bands;
     Eigen::Matrix3Xf occluded_world;
     std::vector<RayHit> hits;
     std::uint64_t rays_shadow = 0, rays_bounce = 0, occluded_count = 0;
   };
   tbb::enumerable_thread_specific<Scratch> scratch_pool([&] {
-    Scratch s;
+    Scratch s(o.order);
     s.world.resize(3, samples);
     s.occluded.resize(samples);
     s.occluded_index.resize(samples);
     s.y_occluded.resize(n, samples);
     s.transfer.resize(n, n);
     s.scratch.resize(n, n);
+    s.diffuse_local.resize(n);
+    s.diffuse_world.resize(n);
+    for (int l = 0; l < o.order; ++l) s.bands.emplace_back(2 * l + 1, 2 * l + 1);
     s.occluded_world.resize(3, samples);
     s.hits.resize(samples);
     return s;
@@ -330,24 +337,25 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
                                                                 -setup.weight);
         }
         s.transfer.triangularView<Eigen::StrictlyUpper>() = s.transfer.transpose();
-        const ShRotation to_local(o.order, frame.transpose().cast<double>());
-        multiply_bands_right(s.transfer, to_local, s.scratch);
+        s.rotation.set(frame.transpose().cast<double>());  // D(F^T): world to local
+        multiply_bands_right(s.transfer, s.rotation, s.bands, s.scratch);
         for (int c = 0; c < channels; ++c) {
           Eigen::Map<RowMatF> m(out.transfer_data(p, c), n, n);
           m.noalias() = setup.brdf[c] * s.transfer;
         }
       } else {
-        Eigen::VectorXf t = setup.cosine_projection;
+        Eigen::VectorXf& t = s.diffuse_local;
+        t = setup.cosine_projection;
         for (int j = 0; j < k; ++j) {
           t -= (setup.weight * setup.directions(2, s.occluded_index[j])) *
                setup.y.col(s.occluded_index[j]);
         }
         // World frame: t_world = D(F) t_local.
-        const Eigen::VectorXd world =
-            ShRotation(o.order, frame.cast<double>()).apply(t.cast<double>());
+        s.rotation.set(frame.cast<double>());
+        s.rotation.apply(t.cast<double>(), s.diffuse_world);
         for (int c = 0; c < channels; ++c) {
           Eigen::Map<Eigen::VectorXf>(out.transfer_data(p, c), n) =
-              setup.rho_over_pi[c] * world.cast<float>();
+              setup.rho_over_pi[c] * s.diffuse_world.cast<float>();
         }
       }
 
@@ -458,12 +466,12 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
                   setup.weight * (s.y_hit.leftCols(count) * s.rows.topRows(count));
               Eigen::Map<RowMatF>(out_ch, n, n).noalias() = setup.brdf[ch] * s.transfer;
             } else {
-              Eigen::RowVectorXf t = Eigen::RowVectorXf::Zero(n);
+              Eigen::Map<Eigen::RowVectorXf> t(out_ch, n);
+              t.setZero();
               for (int h = 0; h < count; ++h) {
                 t += setup.directions(2, hits[h].direction) * s.rows.row(h);
               }
-              Eigen::Map<Eigen::RowVectorXf>(out_ch, n) =
-                  (setup.weight * setup.rho_over_pi[ch]) * t;
+              t *= setup.weight * setup.rho_over_pi[ch];
             }
           }
         }

@@ -93,6 +93,13 @@ const Coefficients& coefficients() {
 
 ShRotation::ShRotation(int order, const Eigen::Matrix3d& rotation) : order_(order) {
   check_order(order, "SH rotation order");
+  bands_.resize(order);
+  for (int l = 0; l < order; ++l) bands_[l].resize(2 * l + 1, 2 * l + 1);
+  set(rotation);
+}
+
+void ShRotation::set(const Eigen::Matrix3d& rotation) {
+  const int order = order_;
   const double orth_err =
       (rotation * rotation.transpose() - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!(orth_err < 1e-6) || !(std::abs(rotation.determinant() - 1.0) < 1e-6)) {
@@ -100,21 +107,17 @@ ShRotation::ShRotation(int order, const Eigen::Matrix3d& rotation) : order_(orde
         "ShRotation: matrix is not a rotation (|R R^T - I| = " + std::to_string(orth_err) +
         ", det = " + std::to_string(rotation.determinant()) + ")");
   }
-  bands_.resize(order);
-  bands_[0] = Eigen::MatrixXd::Ones(1, 1);
+  bands_[0](0, 0) = 1.0;
   if (order == 1) return;
 
   // Band 1 in the (y, z, x) order of y_1^{-1}, y_1^0, y_1^1.
   const int perm[3] = {1, 2, 0};
-  Eigen::MatrixXd r1(3, 3);
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) r1(i, j) = rotation(perm[i], perm[j]);
-  bands_[1] = r1;
+    for (int j = 0; j < 3; ++j) bands_[1](i, j) = rotation(perm[i], perm[j]);
   const Band b1{bands_[1], 1};
 
   for (int l = 2; l < order; ++l) {
     Eigen::MatrixXd& d = bands_[l];
-    d.resize(2 * l + 1, 2 * l + 1);
     const Band prev{bands_[l - 1], l - 1};
     const Coefficients& k = coefficients();
     for (int m = -l; m <= l; ++m) {

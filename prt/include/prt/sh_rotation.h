@@ -24,6 +24,10 @@ class ShRotation {
   // std::invalid_argument otherwise).
   ShRotation(int order, const Eigen::Matrix3d& rotation);
 
+  // Recomputes D for another rotation in place, reusing the band storage (no allocation);
+  // same preconditions as the constructor.
+  void set(const Eigen::Matrix3d& rotation);
+
   int order() const { return order_; }
   // Block of band l, size (2l+1)^2, rows/columns ordered m = -l .. l.
   const Eigen::MatrixXd& band(int l) const { return bands_[l]; }
