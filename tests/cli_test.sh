@@ -63,6 +63,13 @@ expect_code 0; check "bake exits 0" $?
 size=$(stat -c %s "$tmp/cube.prtx" 2>/dev/null || echo 0)
 ((size == 128 + 8 * 81 * 4)); check "bake file size: header + 8 vertices x 81 floats ($size)" $?
 [[ $out =~ rays\ +[0-9.]+\ M ]]; check "bake reports rays" $?
+run info "$tmp/cube.prtx" --mesh "$tmp/cube.obj" --verify
+expect_code 0 && [[ $out =~ order\ 3 ]] && [[ $out == *current* ]]; check "info: order 3, current against its mesh" $?
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$tmp/tri.obj"
+run info "$tmp/cube.prtx" --mesh "$tmp/tri.obj"
+expect_code 1 && [[ $out == *STALE* ]] && [[ $err == *cube.prtx* ]]; check "info: stale against another mesh exits 1" $?
+head -c 100 "$tmp/cube.prtx" >"$tmp/cut.prtx"
+run info "$tmp/cut.prtx"; expect_code 1 && [[ $err == *cut.prtx* ]]; check "info: truncated file exits 1 naming it" $?
 run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --order 11; expect_code 2; check "bake --order 11 is a usage error" $?
 run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --material lambert --exponent 8
 expect_code 2 && [[ $err == *--exponent* ]]; check "bake: --exponent with lambert is a usage error" $?
