@@ -29,7 +29,7 @@ struct LoadOptions {
 
 struct LoadReport {
   std::string path;
-  std::string format;   // OpenImageIO's format name, e.g. "openexr"
+  std::string format;  // OpenImageIO's format name, e.g. "openexr"
   int file_width = 0;
   int file_height = 0;
   int file_channels = 0;

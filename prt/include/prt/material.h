@@ -27,10 +27,10 @@ enum class MaterialKind { kLambert, kPhong, kCookTorrance };
 struct Material {
   MaterialKind kind = MaterialKind::kPhong;
   Eigen::Vector3f albedo = Eigen::Vector3f::Constant(0.5f);  // rho_d per channel, in [0, 1]
-  float specular = 0.3f;    // rho_s in [0, 1]; rho_d + rho_s <= 1 per channel
-  float exponent = 32.f;    // Phong e in [0, 10000]
-  float roughness = 0.3f;   // Cook-Torrance Beckmann m in (0, 1]
-  float f0 = 0.04f;         // Fresnel reflectance at normal incidence, in [0, 1]
+  float specular = 0.3f;   // rho_s in [0, 1]; rho_d + rho_s <= 1 per channel
+  float exponent = 32.f;   // Phong e in [0, 10000]
+  float roughness = 0.3f;  // Cook-Torrance Beckmann m in (0, 1]
+  float f0 = 0.04f;        // Fresnel reflectance at normal incidence, in [0, 1]
 
   bool grey() const { return albedo.x() == albedo.y() && albedo.y() == albedo.z(); }
   int channels() const { return grey() ? 1 : 3; }

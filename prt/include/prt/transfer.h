@@ -30,9 +30,9 @@ struct TransferSet {
   int order = 6;
   int channels = 1;
   std::uint64_t vertex_count = 0;
-  int samples = 0;          // hemisphere directions per vertex
-  int bounces = 0;          // interreflection passes after the shadow pass
-  std::uint64_t seed = 0;   // of the direction set
+  int samples = 0;         // hemisphere directions per vertex
+  int bounces = 0;         // interreflection passes after the shadow pass
+  std::uint64_t seed = 0;  // of the direction set
   Material material;
   std::uint64_t mesh_hash = 0;  // meshes::content_hash of the baked mesh
   std::vector<float> data;
@@ -45,12 +45,12 @@ struct TransferSet {
   std::size_t floats_per_vertex() const { return floats_per_channel() * std::size_t(channels); }
 
   // Glossy: the n x n matrix of vertex p, channel c. Diffuse: an n x 1 column.
-  using MatrixView = Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic,
-                                                    Eigen::RowMajor>>;
+  using MatrixView =
+      Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
   MatrixView transfer(std::uint64_t vertex, int channel) const {
-    return MatrixView(data.data() + vertex * floats_per_vertex() +
-                          std::size_t(channel) * floats_per_channel(),
-                      coefficient_count(), columns());
+    return MatrixView(
+        data.data() + vertex * floats_per_vertex() + std::size_t(channel) * floats_per_channel(),
+        coefficient_count(), columns());
   }
   float* transfer_data(std::uint64_t vertex, int channel) {
     return data.data() + vertex * floats_per_vertex() + std::size_t(channel) * floats_per_channel();
