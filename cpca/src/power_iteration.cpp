@@ -1,0 +1,98 @@
+// Modified power iteration (SLF paper, Appendix, Algorithm 1); see the header for the
+// deliberate differences from the printed listing.
+#include "cpca/power_iteration.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace cpca {
+namespace {
+
+void check_k(const Eigen::Ref<const Eigen::MatrixXd>& f, int k) {
+  if (k < 1 || k > std::min(f.rows(), f.cols())) {
+    throw std::invalid_argument(
+        "PCA: component count must be in [1, min(points, dimension)] = [1, " +
+        std::to_string(std::min(f.rows(), f.cols())) + "], got " + std::to_string(k));
+  }
+}
+
+// A small deterministic generator (splitmix64) for the start vectors.
+double next_uniform(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return double(z >> 11) * 0x1.0p-53;
+}
+
+}  // namespace
+
+PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
+                              const PowerIterationOptions& options) {
+  check_k(f, k);
+  const Eigen::Index m = f.rows(), n = f.cols();
+  PcaResult result;
+  result.gram = m < n;
+  result.basis = Eigen::MatrixXd::Zero(k, n);
+  result.eigenvalues = Eigen::VectorXd::Zero(k);
+  // A is the smaller of F^T F (n x n) and F F^T (m x m); both share the non-zero spectrum.
+  Eigen::MatrixXd a =
+      result.gram ? Eigen::MatrixXd(f * f.transpose()) : Eigen::MatrixXd(f.transpose() * f);
+  const double scale = a.trace();
+  if (!(scale > 0.0)) return result;  // all points equal the mean: nothing to find
+  std::uint64_t state = options.seed;
+  Eigen::VectorXd v(a.rows()), next(a.rows());
+  for (int p = 0; p < k; ++p) {
+    for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = next_uniform(state) - 0.5;
+    v.normalize();
+    double lambda = 0.0, previous_change = std::numeric_limits<double>::infinity();
+    for (int it = 0; it < options.max_iterations; ++it) {
+      ++result.iterations;
+      next.noalias() = a * v;
+      lambda = next.norm();
+      if (!(lambda > 1e-14 * scale)) {  // the remaining spectrum is zero
+        lambda = 0.0;
+        break;
+      }
+      next /= lambda;
+      const double change = (next - v).norm();
+      v.swap(next);
+      // Growth of the change means rounding noise only once it is already small; early on
+      // the change can grow while the iterate turns toward the dominant direction.
+      if (change < options.tolerance || (change > previous_change && change < 1e-6)) break;
+      previous_change = change;
+    }
+    if (lambda == 0.0) break;  // rows p..k-1 stay zero
+    result.eigenvalues[p] = lambda;
+    a.noalias() -= lambda * v * v.transpose();
+    if (result.gram) {
+      // v is a left singular vector u; the principal direction is F^T u / sigma.
+      result.basis.row(p) = (f.transpose() * v).transpose() / std::sqrt(lambda);
+    } else {
+      result.basis.row(p) = v.transpose();
+    }
+  }
+  return result;
+}
+
+PcaResult eigen_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k) {
+  check_k(f, k);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(f.transpose() * f);
+  if (solver.info() != Eigen::Success) throw std::runtime_error("PCA: eigen-solver failed");
+  PcaResult result;
+  result.basis = Eigen::MatrixXd::Zero(k, f.cols());
+  result.eigenvalues = Eigen::VectorXd::Zero(k);
+  const Eigen::Index n = f.cols();
+  for (int p = 0; p < k; ++p) {  // eigenvalues come in increasing order
+    result.eigenvalues[p] = std::max(0.0, solver.eigenvalues()[n - 1 - p]);
+    result.basis.row(p) = solver.eigenvectors().col(n - 1 - p).transpose();
+  }
+  return result;
+}
+
+}  // namespace cpca
