@@ -14,7 +14,10 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path scratch(const std::string& name) {
-  return test_support::scratch("common", name);
+  // One directory per test: CTest runs tests in parallel processes, and these tests count
+  // the files in their directory.
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  return test_support::scratch("common/" + test, name);
 }
 using test_support::slurp;
 
