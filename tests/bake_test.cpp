@@ -175,16 +175,22 @@ struct Occluder {
 
 Occluder occluder_scene() {
   Occluder s;
-  const meshes::Mesh plane = meshes::make_plane(6.f, 24, 0.f);
-  meshes::Mesh ball = meshes::make_sphere(0.5f, 48, 24, meshes::Vec3(0, 1.5f, 0));
-  s.plane_triangles = plane.triangle_count();
-  s.mesh = meshes::merge({plane, ball});
+  s.mesh = meshes::make_plane_and_sphere(6.f, 24, 0.5f, 1.5f, 48, 24);
+  // The plane comes first in the merged mesh; its vertices are the ones at y = 0 (the sphere
+  // spans y in [1, 2]).
+  auto on_plane = [&](std::uint32_t v) { return s.mesh.positions[v].y() == 0.f; };
+  while (s.plane_triangles < s.mesh.triangle_count()) {
+    const meshes::Triangle& t = s.mesh.triangles[s.plane_triangles];
+    if (!(on_plane(t[0]) && on_plane(t[1]) && on_plane(t[2]))) break;
+    ++s.plane_triangles;
+  }
+  EXPECT_EQ(s.plane_triangles, std::size_t(24 * 24 * 2));  // the whole 24 x 24 plane grid
   for (const Vec3d& target : {Vec3d(0, 0, 0), Vec3d(0.5, 0, 0), Vec3d(1.0, 0, 0.5)}) {
     std::size_t best = 0;
     double dist = 1e30;
-    for (std::size_t v = 0; v < plane.vertex_count(); ++v) {
+    for (std::uint32_t v = 0; v < s.mesh.vertex_count(); ++v) {
       const double d = (s.mesh.positions[v].cast<double>() - target).norm();
-      if (d < dist) dist = d, best = v;
+      if (on_plane(v) && d < dist) dist = d, best = v;
     }
     s.probes.push_back(best);
   }
