@@ -38,6 +38,7 @@ struct CompressedSet {
   int columns = 36;        // n for glossy transfer matrices, 1 for diffuse vectors
   std::uint64_t mesh_hash = 0;      // meshes::content_hash of the baked mesh
   std::uint64_t transfer_hash = 0;  // FNV-1a of the transfer file's payload (staleness)
+  std::string mesh_path;  // the baked mesh as given to prtr bake, for tools needing geometry
 
   // Sizes.
   std::uint64_t vertex_count = 0;
