@@ -8,13 +8,12 @@
 // Average triangle overdraw = sum over triangles of that count / triangle count.
 #pragma once
 
-#include <array>
+#include "cpca/geometry.h"
+
 #include <cstdint>
 #include <vector>
 
 namespace cpca {
-
-using TriangleIndices = std::array<std::uint32_t, 3>;
 
 // vec4 registers one cluster's constants take in the renderer's vertex shader: the n x 3
 // RGB radiance vectors a_k and b_kj (j < N), packed tightly as floats into vec4s:
