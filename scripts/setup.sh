@@ -9,7 +9,8 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
-  libopenimageio-dev libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
+  libopenimageio-dev libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev libmetis-dev
+  libmeshoptimizer-dev
   glmark2-data blender-data
 )
 

@@ -16,11 +16,10 @@ int registers_per_cluster(int order, int components) {
 int clusters_per_pass(int register_budget, int order, int components) {
   const int cost = registers_per_cluster(order, components);
   if (register_budget < cost)
-    throw std::invalid_argument("register budget " + std::to_string(register_budget) +
-                                " is below one cluster's cost of " + std::to_string(cost) +
-                                " vec4 (order " + std::to_string(order) + ", " +
-                                std::to_string(components) +
-                                " PCs): raise --register-budget or lower the order or PCs");
+    throw std::invalid_argument(
+        "register budget " + std::to_string(register_budget) + " is below one cluster's cost of " +
+        std::to_string(cost) + " vec4 (order " + std::to_string(order) + ", " +
+        std::to_string(components) + " PCs): raise --register-budget or lower the order or PCs");
   return register_budget / cost;
 }
 
@@ -90,8 +89,7 @@ std::vector<std::uint32_t> checked_pass_of(const std::vector<std::uint32_t>& clu
 }  // namespace
 
 OverdrawStats overdraw(const std::vector<std::uint32_t>& cluster_of,
-                       const std::vector<TriangleIndices>& triangles,
-                       const SuperClusters& groups) {
+                       const std::vector<TriangleIndices>& triangles, const SuperClusters& groups) {
   const std::vector<std::uint32_t> pass_of = checked_pass_of(cluster_of, groups);
   OverdrawStats stats;
   stats.triangles_per_pass.assign(groups.passes.size(), 0);
@@ -118,6 +116,18 @@ std::vector<std::vector<std::uint32_t>> triangles_per_pass(
     for (int j = 0; j < count; ++j) lists[p[j]].push_back(std::uint32_t(i));
   }
   return lists;
+}
+
+std::vector<std::uint8_t> triangle_pass_counts(const std::vector<std::uint32_t>& cluster_of,
+                                               const std::vector<TriangleIndices>& triangles,
+                                               const SuperClusters& groups) {
+  const std::vector<std::uint32_t> pass_of = checked_pass_of(cluster_of, groups);
+  std::vector<std::uint8_t> counts(triangles.size());
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    std::uint32_t p[3];
+    counts[i] = std::uint8_t(passes_of_triangle(cluster_of, pass_of, triangles[i], p));
+  }
+  return counts;
 }
 
 }  // namespace cpca

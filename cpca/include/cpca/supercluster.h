@@ -54,4 +54,10 @@ std::vector<std::vector<std::uint32_t>> triangles_per_pass(
     const std::vector<std::uint32_t>& cluster_of, const std::vector<TriangleIndices>& triangles,
     const SuperClusters& groups);
 
+// Per triangle, how many passes draw it (1..3): the overdraw picture's colour index. Its sum
+// is overdraw(...).triangles_drawn.
+std::vector<std::uint8_t> triangle_pass_counts(const std::vector<std::uint32_t>& cluster_of,
+                                               const std::vector<TriangleIndices>& triangles,
+                                               const SuperClusters& groups);
+
 }  // namespace cpca

@@ -1,0 +1,63 @@
+// cpca/supercluster_refine.h: local search that lowers the exact triangle overdraw of a
+// grouping by moving single clusters into passes with room and by swapping two clusters
+// of different passes, keeping every pass within capacity.
+//
+// Every step is evaluated exactly on the clusters' hyperedges (cpca/supercluster_incidence.h)
+// and applied only when it strictly lowers the triangles drawn, so refinement never makes a
+// grouping worse and always terminates. Only passes holding a neighbour of a cluster are
+// tried for it: moving or swapping a cluster into a pass where none of its triangles'
+// other clusters live cannot lower that cluster's draws, and the partner's side of such a
+// swap is examined when the partner itself is visited.
+#pragma once
+
+#include "cpca/supercluster_incidence.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace cpca {
+
+class GroupingLocalSearch {
+ public:
+  // pass_of: one entry per cluster, each < passes; pass sizes must be <= per_pass.
+  GroupingLocalSearch(const ClusterIncidence& incidence, int per_pass,
+                      std::vector<std::uint32_t> pass_of, int passes);
+
+  std::uint64_t drawn() const { return drawn_; }
+  const std::vector<std::uint32_t>& pass_of() const { return pass_of_; }
+  const std::vector<std::uint32_t>& members(std::uint32_t pass) const { return members_[pass]; }
+  int pass_count() const { return int(members_.size()); }
+  int per_pass() const { return per_pass_; }
+
+  // Change in triangles drawn if cluster c moved to pass q / if c and d traded passes.
+  std::int64_t delta_move(std::uint32_t c, std::uint32_t q) const;
+  std::int64_t delta_swap(std::uint32_t c, std::uint32_t d) const;
+  // Apply them (no capacity check beyond an always-on one for moves).
+  void move(std::uint32_t c, std::uint32_t q);
+  void swap(std::uint32_t c, std::uint32_t d);
+
+  // Best-improvement steps from the clusters in `worklist` (all clusters when empty),
+  // re-examining the neighbourhood of every change, until no step improves. Returns the
+  // number of steps applied.
+  int descend(std::vector<std::uint32_t> worklist = {});
+
+  // Clusters whose best step may have changed after c changed pass: c, the members of
+  // its old and new pass and all their neighbours. Appended to `out`.
+  void affected(std::uint32_t c, std::uint32_t old_pass, std::vector<std::uint32_t>& out) const;
+
+  SuperClusters groups() const { return groups_from_pass_of(pass_of_); }
+
+ private:
+  const ClusterIncidence* inc_;  // a pointer so that searches can be copied and assigned
+  int per_pass_;
+  std::vector<std::uint32_t> pass_of_;
+  std::vector<std::vector<std::uint32_t>> members_;
+  std::uint64_t drawn_ = 0;
+};
+
+// Local search from `start` (a grouping of the incidence's clusters); the result is never
+// worse than the start and uses at most as many passes.
+SuperClusters refine_grouping(const ClusterIncidence& incidence, int per_pass,
+                              const SuperClusters& start);
+
+}  // namespace cpca
