@@ -55,7 +55,7 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
       ++result.iterations;
       next.noalias() = a * v;
       lambda = next.norm();
-      if (!(lambda > 1e-14 * scale)) {  // the remaining spectrum is zero
+      if (!(lambda > 1e-12 * scale)) {  // the remaining spectrum is rounding noise
         lambda = 0.0;
         break;
       }
@@ -70,12 +70,22 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
     if (lambda == 0.0) break;  // rows p..k-1 stay zero
     result.eigenvalues[p] = lambda;
     a.noalias() -= lambda * v * v.transpose();
-    if (result.gram) {
-      // v is a left singular vector u; the principal direction is F^T u / sigma.
-      result.basis.row(p) = (f.transpose() * v).transpose() / std::sqrt(lambda);
-    } else {
-      result.basis.row(p) = v.transpose();
+    Eigen::RowVectorXd direction = result.gram ? Eigen::RowVectorXd((f.transpose() * v).transpose())
+                                               : Eigen::RowVectorXd(v.transpose());
+    // v is a left singular vector u on the Gram path; the principal direction is F^T u /
+    // sigma. Orthogonalising against the earlier rows (twice, for stability) and
+    // renormalising keeps the basis orthonormal even for eigenvalues near the noise floor,
+    // where dividing by sigma would amplify rounding.
+    for (int pass = 0; pass < 2; ++pass)
+      for (int q = 0; q < p; ++q)
+        direction -= direction.dot(result.basis.row(q)) * result.basis.row(q);
+    const double norm = direction.norm();
+    const double expected = result.gram ? std::sqrt(lambda) : 1.0;
+    if (!(norm > 1e-6 * expected)) {  // nothing left but rounding noise
+      result.eigenvalues[p] = 0.0;
+      break;
     }
+    result.basis.row(p) = direction / norm;
   }
   return result;
 }

@@ -33,9 +33,9 @@ const char* pca_solver_name(PcaSolver solver);  // "power", "eigen"
 
 struct CompressedSet {
   // Layout of the source transfer (copied from the bake).
-  int order = 6;           // SH order; n = order^2
-  int channels = 1;        // 1 (grey) or 3 (RGB) transfer matrices per vertex
-  int columns = 36;        // n for glossy transfer matrices, 1 for diffuse vectors
+  int order = 6;                    // SH order; n = order^2
+  int channels = 1;                 // 1 (grey) or 3 (RGB) transfer matrices per vertex
+  int columns = 36;                 // n for glossy transfer matrices, 1 for diffuse vectors
   std::uint64_t mesh_hash = 0;      // meshes::content_hash of the baked mesh
   std::uint64_t transfer_hash = 0;  // FNV-1a of the transfer file's payload (staleness)
   std::string mesh_path;  // the baked mesh as given to prtr bake, for tools needing geometry
@@ -72,8 +72,8 @@ struct CompressedSet {
   }
   // N x D: the principal components of cluster k, one per row.
   BasisMap basis(int k) const {
-    return BasisMap(bases.data() + std::size_t(k) * component_count * dimension(),
-                    component_count, Eigen::Index(dimension()));
+    return BasisMap(bases.data() + std::size_t(k) * component_count * dimension(), component_count,
+                    Eigen::Index(dimension()));
   }
   RowMap weight_row(std::uint64_t p) const {
     return RowMap(weights.data() + p * std::size_t(component_count), component_count);

@@ -1,0 +1,37 @@
+// cpca/cluster_pca.h: the PCA half of CPCA. Given a clustering, fit every cluster's mean and
+// N principal components (power iteration or Eigen's solver, cpca/power_iteration.h) and
+// project each vertex onto its cluster's basis; and the squared reconstruction error of every
+// point under every cluster's affine subspace, which iterative CPCA and the overdraw-aware
+// reassignment compare.
+#pragma once
+
+#include "cpca/compressed.h"
+#include "cpca/metrics.h"
+#include "cpca/power_iteration.h"
+
+#include <vector>
+
+namespace cpca {
+
+struct ClusterPcaStats {
+  int power_iterations = 0;  // total over clusters (0 for the Eigen solver)
+};
+
+// Uses set.cluster_of, set.cluster_count, set.component_count; fills set.vertex_count, means,
+// bases and weights. A cluster with fewer than N + 1 points gets zero rows past its rank.
+// Returns each vertex's squared reconstruction error (double). Clusters run in parallel.
+std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
+                                    PcaSolver solver, const PowerIterationOptions& power = {},
+                                    ClusterPcaStats* stats = nullptr);
+
+// V x K: ||x_p - m_k||^2 - ||B_k (x_p - m_k)||^2 for every point and cluster, i.e. the squared
+// distance from x_p to cluster k's affine subspace (bases orthonormal). Computed as two matrix
+// products per row block; clamped at 0. `x_squared_norms` holds ||x_p||^2.
+DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
+                              const Eigen::VectorXf& x_squared_norms, const CompressedSet& set);
+
+// The same for one point and one cluster, in double.
+double subspace_distance(const Eigen::Ref<const Eigen::RowVectorXf>& x, const CompressedSet& set,
+                         int cluster);
+
+}  // namespace cpca

@@ -1,0 +1,84 @@
+// cpca/compress.h: the whole compression of a transfer set, in the order the thesis and
+// Sloan et al. 2003 use: LBG clustering (optionally geometry-coherent), PCA per cluster,
+// optionally iterative CPCA, optionally the overdraw-aware reassignment, then the metrics.
+#pragma once
+
+#include "cpca/compressed.h"
+#include "cpca/geometry.h"
+#include "cpca/lbg.h"
+#include "cpca/metrics.h"
+#include "cpca/overdraw_reduction.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace cpca {
+
+// The layout of a data row (compressed.h). Order 0 means "infer from the dimension": the
+// first of diffuse grey (n), glossy grey (n^2), diffuse RGB (3n), glossy RGB (3n^2) whose size
+// matches, for order 1..10.
+struct DataLayout {
+  int order = 0;
+  int channels = 1;
+  int columns = 1;
+};
+
+struct CompressOptions {
+  DataLayout layout;
+  int clusters = 256;
+  int components = 8;
+  ClusterMethod method = ClusterMethod::kLbg;
+  PcaSolver solver = PcaSolver::kPowerIteration;
+  double alpha = 0.0;               // geometry coherence (assignment.h); needs geometry when > 0
+  bool overdraw_reduction = false;  // needs geometry
+  OverdrawReductionOptions overdraw;
+  std::uint64_t seed = 1;
+  double lbg_threshold = 1e-4;  // converged ratio (thesis eq. 5)
+  int lbg_max_iterations = 200;
+  double cpca_threshold = 1e-4;  // iterative CPCA stops when the error falls less than this
+  int cpca_max_iterations = 20;
+};
+
+// Triangles whose three vertices lie in 1, 2 or 3 distinct clusters.
+struct TriangleSpan {
+  std::uint64_t one = 0, two = 0, three = 0;
+  std::uint64_t multi() const { return two + three; }
+};
+TriangleSpan triangle_span(const std::vector<std::uint32_t>& cluster_of,
+                           const std::vector<TriangleIndices>& triangles);
+
+struct CompressReport {
+  double lbg_seconds = 0, pca_seconds = 0, cpca_seconds = 0, overdraw_seconds = 0,
+         total_seconds = 0;
+  double clustering_seconds() const { return lbg_seconds + cpca_seconds + overdraw_seconds; }
+  int lbg_iterations = 0;
+  int cpca_iterations = 0;
+  int splits = 0;  // null clusters filled
+  int power_iterations = 0;
+  std::vector<double> lbg_energy;  // per LBG iteration
+  std::vector<double> cpca_error;  // total squared error after each iterative CPCA step
+  OverdrawReductionResult overdraw;
+  ErrorMetrics error;
+  SizeMetrics size;
+  bool has_geometry = false;
+  TriangleSpan span;  // of the final clustering, when geometry was given
+};
+
+// `stage` is "lbg", "pca", "cpca" or "overdraw"; `fraction` in [0, 1] is an estimate.
+using CompressProgress = std::function<void(const std::string& stage, double fraction)>;
+
+// Compresses V x D data (one row per vertex). Geometry is required for alpha > 0 and the
+// overdraw reduction, optional otherwise (it adds the triangle span to the report). The
+// returned set has the layout, sizes, clustering, fit and method fields filled; the hashes
+// and mesh path are the caller's. Throws std::invalid_argument
+// naming the bad parameter.
+CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                       const Geometry* geometry = nullptr, CompressReport* report = nullptr,
+                       const CompressProgress& progress = {});
+
+// Average SE, relative and max error of a set against its data, by reconstructing every row
+// (a code path independent of the compressor's own bookkeeping).
+ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set);
+
+}  // namespace cpca

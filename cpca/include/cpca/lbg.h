@@ -1,0 +1,64 @@
+// cpca/lbg.h: LBG (k-means) clustering of the per-vertex transfer data, as in thesis
+// Fig. 3.2, and the null-cluster avoidance that iterative CPCA shares.
+//
+//  0. Initial means: uniform random points in the data's hyper-box (per-dimension min/max).
+//  1. Assign every point to its nearest mean (distances as matrix products, assignment.h), or
+//     with geometry coherence when one is given.
+//  -  Null-cluster avoidance: while a cluster is empty, split the most populated cluster in two
+//     along its principal direction (a few power iterations) and give one half to the empty one.
+//  2. Update every mean to the average of its points.
+//  3. Energy E_i = sum_p ||x_p - mean||^2 (eq. 4); stop when E_i = 0 or the converged ratio
+//     (E_{i-1} - E_i) / E_{i-1} (eq. 5) falls below the threshold in magnitude (with geometry
+//     coherence E may rise while the total cost falls), or after max_iterations.
+#pragma once
+
+#include "cpca/assignment.h"
+#include "cpca/metrics.h"
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+namespace cpca {
+
+struct LbgOptions {
+  int clusters = 256;
+  double threshold = 1e-4;  // on the converged ratio (eq. 5)
+  int max_iterations = 200;
+  std::uint64_t seed = 1;  // of the hyper-box initialisation
+};
+
+struct LbgResult {
+  std::vector<std::uint32_t> cluster_of;
+  DataMatrix means;  // K x D
+  int iterations = 0;
+  int splits = 0;              // null clusters filled by splitting
+  std::vector<double> energy;  // E_i after each iteration
+};
+
+// Called after each iteration with its number (1-based), energy and converged ratio.
+using LbgCallback = std::function<void(int iteration, double energy, double ratio)>;
+
+// Requires 1 <= clusters <= rows (std::invalid_argument otherwise). Deterministic for a seed.
+LbgResult lbg(const Eigen::Ref<const DataMatrix>& x, const LbgOptions& options,
+              const GeometryCoherence* coherence = nullptr, const LbgCallback& callback = {});
+
+// Fills every empty cluster (ids < cluster_count) by splitting the most populated one along
+// its principal direction. Returns the number of splits. Throws std::invalid_argument when
+// there are more clusters than points.
+int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
+                         std::vector<std::uint32_t>& cluster_of, int cluster_count);
+
+// Mean of each cluster's rows (K x D), accumulated in double. Empty clusters get zero rows.
+DataMatrix cluster_means(const Eigen::Ref<const DataMatrix>& x,
+                         const std::vector<std::uint32_t>& cluster_of, int cluster_count);
+
+// sum_p ||x_p - means[cluster_of[p]]||^2 in double, with a fixed reduction order.
+double clustering_energy(const Eigen::Ref<const DataMatrix>& x,
+                         const std::vector<std::uint32_t>& cluster_of, const DataMatrix& means);
+
+// Members of each cluster, ascending.
+std::vector<std::vector<std::uint32_t>> cluster_members(
+    const std::vector<std::uint32_t>& cluster_of, int cluster_count);
+
+}  // namespace cpca

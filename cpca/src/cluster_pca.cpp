@@ -1,0 +1,116 @@
+#include "cpca/cluster_pca.h"
+
+#include "cpca/lbg.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <numeric>
+
+namespace cpca {
+
+std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
+                                    PcaSolver solver, const PowerIterationOptions& power,
+                                    ClusterPcaStats* stats) {
+  const int k = set.cluster_count, n = set.component_count;
+  const Eigen::Index d = x.cols();
+  set.vertex_count = std::uint64_t(x.rows());
+  set.solver = solver;
+  set.means.assign(std::size_t(k) * std::size_t(d), 0.f);
+  set.bases.assign(std::size_t(k) * std::size_t(n) * std::size_t(d), 0.f);
+  set.weights.assign(std::size_t(x.rows()) * std::size_t(n), 0.f);
+  std::vector<double> error(std::size_t(x.rows()), 0.0);
+  const auto members = cluster_members(set.cluster_of, k);
+  // Largest clusters first, so one big cluster does not finish alone at the end.
+  std::vector<int> order(static_cast<std::size_t>(k));
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return members[std::size_t(a)].size() > members[std::size_t(b)].size();
+  });
+  std::atomic<int> iterations{0};
+  tbb::parallel_for(0, k, [&](int o) {
+    const int c = order[std::size_t(o)];
+    const auto& m = members[std::size_t(c)];
+    if (m.empty()) return;
+    const Eigen::Index rows = Eigen::Index(m.size());
+    Eigen::MatrixXd f(rows, d);
+    for (Eigen::Index i = 0; i < rows; ++i) f.row(i) = x.row(m[std::size_t(i)]).cast<double>();
+    const Eigen::RowVectorXd mean = f.colwise().mean();
+    f.rowwise() -= mean;
+    Eigen::Map<Eigen::RowVectorXf>(set.means.data() + std::size_t(c) * std::size_t(d), d) =
+        mean.cast<float>();
+    Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(n, d);
+    const int rank_limit = int(std::min<Eigen::Index>({Eigen::Index(n), rows, d}));
+    if (rank_limit >= 1) {
+      const PcaResult pca = solver == PcaSolver::kEigen ? eigen_pca(f, rank_limit)
+                                                        : power_iteration_pca(f, rank_limit, power);
+      basis.topRows(rank_limit) = pca.basis;
+      iterations += pca.iterations;
+    }
+    // Store the float basis and project onto it, so weights match what the renderer
+    // reconstructs from the stored numbers.
+    Eigen::Map<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> stored(
+        set.bases.data() + std::size_t(c) * std::size_t(n) * std::size_t(d), n, d);
+    stored = basis.cast<float>();
+    const Eigen::MatrixXd b = stored.cast<double>();
+    const Eigen::MatrixXd w = f * b.transpose();  // rows x n
+    const Eigen::RowVectorXd mean_f = mean.cast<float>().cast<double>();
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      const std::uint32_t p = m[std::size_t(i)];
+      for (int j = 0; j < n; ++j)
+        set.weights[std::size_t(p) * std::size_t(n) + std::size_t(j)] = float(w(i, j));
+      const Eigen::RowVectorXd wf = Eigen::Map<const Eigen::RowVectorXf>(
+                                        set.weights.data() + std::size_t(p) * std::size_t(n), n)
+                                        .cast<double>();
+      const Eigen::RowVectorXd residual = x.row(p).cast<double>() - mean_f - wf * b;
+      error[p] = residual.squaredNorm();
+    }
+  });
+  if (stats) stats->power_iterations = iterations;
+  return error;
+}
+
+DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
+                              const Eigen::VectorXf& x_squared_norms, const CompressedSet& set) {
+  const int k = set.cluster_count, n = set.component_count;
+  const Eigen::Index v = x.rows(), d = x.cols();
+  const Eigen::Map<const DataMatrix> means(set.means.data(), k, d);
+  const Eigen::Map<const DataMatrix> bases(set.bases.data(), Eigen::Index(k) * n, d);
+  // Per cluster: ||m_k||^2 and c_k = B_k m_k, so that B_k (x - m_k) = B_k x - c_k.
+  const Eigen::RowVectorXf mean_norms = means.rowwise().squaredNorm().transpose();
+  Eigen::RowVectorXf c(Eigen::Index(k) * n);
+  for (int j = 0; j < k; ++j)
+    c.segment(Eigen::Index(j) * n, n) =
+        (bases.middleRows(Eigen::Index(j) * n, n) * means.row(j).transpose()).transpose();
+  DataMatrix out(v, k);
+  constexpr Eigen::Index kBlock = 256;
+  tbb::parallel_for(Eigen::Index(0), (v + kBlock - 1) / kBlock, [&](Eigen::Index b) {
+    const Eigen::Index begin = b * kBlock, rows = std::min(kBlock, v - begin);
+    const auto xb = x.middleRows(begin, rows);
+    DataMatrix proj(rows, Eigen::Index(k) * n);
+    if (n > 0) proj.noalias() = xb * bases.transpose();
+    auto block = out.middleRows(begin, rows);
+    block.noalias() = -2.f * xb * means.transpose();
+    block.rowwise() += mean_norms;
+    block.colwise() += x_squared_norms.segment(begin, rows);
+    if (n > 0) {
+      proj.rowwise() -= c;
+      for (int j = 0; j < k; ++j)
+        block.col(j) -= proj.middleCols(Eigen::Index(j) * n, n).rowwise().squaredNorm();
+    }
+    block = block.cwiseMax(0.f);
+  });
+  return out;
+}
+
+double subspace_distance(const Eigen::Ref<const Eigen::RowVectorXf>& x, const CompressedSet& set,
+                         int cluster) {
+  const Eigen::RowVectorXd centred = (x - set.mean(cluster)).cast<double>();
+  if (set.component_count == 0) return centred.squaredNorm();
+  const Eigen::MatrixXd b = set.basis(cluster).cast<double>();
+  const Eigen::VectorXd w = b * centred.transpose();
+  return std::max(0.0, centred.squaredNorm() - w.squaredNorm());
+}
+
+}  // namespace cpca

@@ -1,0 +1,216 @@
+#include "cpca/compress.h"
+
+#include "cpca/cluster_pca.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace cpca {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+double sum(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0);
+}
+
+DataLayout resolve_layout(const DataLayout& given, Eigen::Index d);
+
+void check(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& o,
+           const Geometry* geometry) {
+  auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
+  if (data.rows() < 1 || data.cols() < 1) bad("compress: the data is empty");
+  if (o.clusters < 1 || Eigen::Index(o.clusters) > data.rows())
+    bad("clusters must be in [1, vertices] = [1, " + std::to_string(data.rows()) + "], got " +
+        std::to_string(o.clusters));
+  if (o.components < 0 || Eigen::Index(o.components) >= data.cols())
+    bad("PCs must be in [0, dimension - 1] = [0, " + std::to_string(data.cols() - 1) + "], got " +
+        std::to_string(o.components));
+  if (!(o.alpha >= 0) || !std::isfinite(o.alpha))
+    bad("alpha must be finite and >= 0, got " + std::to_string(o.alpha));
+  if ((o.alpha > 0 || o.overdraw_reduction) && !geometry)
+    bad("geometry coherence and overdraw reduction need the mesh");
+  if (geometry && geometry->positions.size() != std::size_t(data.rows()))
+    bad("the mesh has " + std::to_string(geometry->positions.size()) +
+        " vertices but the transfer has " + std::to_string(data.rows()) +
+        ": bake the transfer from this mesh again");
+  resolve_layout(o.layout, data.cols());
+  if (!data.allFinite()) bad("the transfer data holds NaN or infinite values: bake it again");
+}
+
+DataLayout resolve_layout(const DataLayout& given, Eigen::Index d) {
+  auto size = [](const DataLayout& l) {
+    return Eigen::Index(l.channels) * l.order * l.order * l.columns;
+  };
+  if (given.order != 0) {
+    if (size(given) != d)
+      throw std::invalid_argument("compress: layout (order " + std::to_string(given.order) + ", " +
+                                  std::to_string(given.channels) + " channels, " +
+                                  std::to_string(given.columns) + " columns) does not match " +
+                                  "the data dimension " + std::to_string(d));
+    return given;
+  }
+  for (int channels : {1, 3})
+    for (bool glossy : {false, true})
+      for (int order = 1; order <= 10; ++order) {
+        const DataLayout l{order, channels, glossy ? order * order : 1};
+        if (size(l) == d) return l;
+      }
+  throw std::invalid_argument("compress: data dimension " + std::to_string(d) +
+                              " is not the size of an SH transfer vector or matrix");
+}
+
+}  // namespace
+
+TriangleSpan triangle_span(const std::vector<std::uint32_t>& cluster_of,
+                           const std::vector<TriangleIndices>& triangles) {
+  TriangleSpan s;
+  for (const TriangleIndices& t : triangles) {
+    const std::uint32_t a = cluster_of[t[0]], b = cluster_of[t[1]], c = cluster_of[t[2]];
+    const int distinct = 1 + (b != a) + (c != a && c != b);
+    (distinct == 1 ? s.one : distinct == 2 ? s.two : s.three)++;
+  }
+  return s;
+}
+
+ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set) {
+  validate(set);
+  if (set.vertex_count != std::uint64_t(data.rows()) || set.dimension() != std::size_t(data.cols()))
+    throw std::invalid_argument("error_metrics: the set does not match the data's shape");
+  DataMatrix reconstruction(data.rows(), data.cols());
+  tbb::parallel_for(Eigen::Index(0), data.rows(), [&](Eigen::Index p) {
+    reconstruct_vertex(set, std::uint64_t(p), reconstruction.row(p).data());
+  });
+  return error_metrics(data, reconstruction);
+}
+
+CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                       const Geometry* geometry, CompressReport* report,
+                       const CompressProgress& progress) {
+  check(data, options, geometry);
+  CompressReport local;
+  CompressReport& r = report ? *report : local;
+  r = CompressReport{};
+  const auto start = Clock::now();
+  auto notify = [&](const char* stage, double fraction) {
+    if (progress) progress(stage, std::clamp(fraction, 0.0, 1.0));
+  };
+
+  // 1. LBG. Progress: log of the converged ratio against log of the threshold.
+  auto t = Clock::now();
+  std::unique_ptr<GeometryCoherence> coherence;
+  if (options.alpha > 0)
+    coherence =
+        std::make_unique<GeometryCoherence>(*geometry, std::size_t(data.rows()), options.alpha);
+  LbgOptions lbg_options;
+  lbg_options.clusters = options.clusters;
+  lbg_options.threshold = options.lbg_threshold;
+  lbg_options.max_iterations = options.lbg_max_iterations;
+  lbg_options.seed = options.seed;
+  notify("lbg", 0);
+  LbgResult clustering = lbg(data, lbg_options, coherence.get(), [&](int it, double, double ratio) {
+    const double by_ratio = ratio > 0 && options.lbg_threshold > 0
+                                ? std::log(ratio) / std::log(options.lbg_threshold)
+                                : 1.0;
+    notify("lbg", std::max(by_ratio, double(it) / options.lbg_max_iterations));
+  });
+  r.lbg_seconds = seconds_since(t);
+  r.lbg_iterations = clustering.iterations;
+  r.splits = clustering.splits;
+  r.lbg_energy = clustering.energy;
+
+  const DataLayout layout = resolve_layout(options.layout, data.cols());
+  CompressedSet set;
+  set.order = layout.order;
+  set.channels = layout.channels;
+  set.columns = layout.columns;
+  set.cluster_count = options.clusters;
+  set.component_count = options.components;
+  set.method = options.method;
+  set.alpha = options.alpha;
+  set.overdraw_reduction = options.overdraw_reduction;
+  set.seed = options.seed;
+  set.cluster_of = std::move(clustering.cluster_of);
+
+  // 2. PCA per cluster.
+  t = Clock::now();
+  notify("pca", 0);
+  PowerIterationOptions power;
+  power.seed = options.seed;
+  ClusterPcaStats stats;
+  std::vector<double> vertex_error = fit_cluster_pca(data, set, options.solver, power, &stats);
+  r.power_iterations += stats.power_iterations;
+  r.pca_seconds = seconds_since(t);
+  notify("pca", 1);
+
+  // 3. Iterative CPCA: reassign to the best-reconstructing cluster, refit, until the error
+  // stops falling; a step that raises it (possible with coherence) is undone.
+  int iterations = clustering.iterations;
+  if (options.method == ClusterMethod::kIterative) {
+    t = Clock::now();
+    const Eigen::VectorXf norms = data.rowwise().squaredNorm();
+    double error = sum(vertex_error);
+    r.cpca_error.push_back(error);
+    for (int it = 1; it <= options.cpca_max_iterations && error > 0; ++it) {
+      notify("cpca", double(it - 1) / options.cpca_max_iterations);
+      const DataMatrix d2 = subspace_distances(data, norms, set);
+      CompressedSet next = set;
+      next.cluster_of =
+          coherence ? coherence->assign(d2, set.cluster_of, std::sqrt(error / double(data.rows())))
+                    : argmin_rows(d2);
+      r.splits += split_empty_clusters(data, next.cluster_of, set.cluster_count);
+      std::vector<double> next_error = fit_cluster_pca(data, next, options.solver, power, &stats);
+      r.power_iterations += stats.power_iterations;
+      const double e = sum(next_error);
+      r.cpca_iterations = it;
+      if (!(e < error)) break;
+      const bool converged = (error - e) / error < options.cpca_threshold;
+      set = std::move(next);
+      vertex_error = std::move(next_error);
+      error = e;
+      r.cpca_error.push_back(error);
+      if (converged) break;
+    }
+    iterations += r.cpca_iterations;
+    r.cpca_seconds = seconds_since(t);
+    notify("cpca", 1);
+  }
+
+  // 4. Overdraw-aware reassignment, then a refit for the new membership.
+  if (options.overdraw_reduction) {
+    t = Clock::now();
+    notify("overdraw", 0);
+    r.overdraw = reduce_overdraw(data, *geometry, set, vertex_error, options.overdraw);
+    vertex_error = fit_cluster_pca(data, set, options.solver, power, &stats);
+    r.power_iterations += stats.power_iterations;
+    r.overdraw_seconds = seconds_since(t);
+    notify("overdraw", 1);
+  }
+  set.iterations = iterations;
+
+  const double total = sum(vertex_error);
+  const Eigen::VectorXd row_norms = data.rowwise().squaredNorm().cast<double>();
+  const double norm = row_norms.sum();
+  r.error.average_squared_error = total / double(data.rows());
+  r.error.relative_error = norm > 0 ? total / norm : 0.0;
+  r.error.max_squared_error = *std::max_element(vertex_error.begin(), vertex_error.end());
+  r.size = size_metrics(std::uint64_t(data.rows()), std::uint64_t(data.cols()),
+                        std::uint64_t(options.clusters), std::uint64_t(options.components));
+  if (geometry) {
+    r.has_geometry = true;
+    r.span = triangle_span(set.cluster_of, geometry->triangles);
+  }
+  r.total_seconds = seconds_since(start);
+  return set;
+}
+
+}  // namespace cpca
