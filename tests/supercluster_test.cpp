@@ -239,6 +239,38 @@ TEST(SuperclusterStrategies, RefinementNeverWorseThanItsStart) {
   }
 }
 
+TEST(SuperclusterRefine, FastDeltasMatchReferenceAndRecount) {
+  // The pull table is updated incrementally; after every random step, each fast delta must
+  // equal the hyperedge recount, and drawn() the full recount (all integers: exact).
+  for (std::uint32_t seed = 0; seed < 20; ++seed) {
+    std::mt19937 rng(seed + 500u);
+    const int k = 3 + int(rng() % 30);
+    const int per_pass = 2 + int(rng() % 4);
+    const ClusteredMesh m = random_mesh(seed + 500u, k);
+    const cpca::ClusterIncidence inc = cpca::cluster_incidence(m.input(per_pass));
+    const int passes = (k + per_pass - 1) / per_pass + 1;  // one spare pass: moves possible
+    const SuperClusters start = cpca::group_in_order(k, per_pass);
+    cpca::GroupingLocalSearch search(inc, per_pass, start.pass_of, passes);
+    for (int step = 0; step < 200; ++step) {
+      const std::uint32_t c = std::uint32_t(rng() % std::uint32_t(k));
+      const std::uint32_t d = std::uint32_t(rng() % std::uint32_t(k));
+      const std::uint32_t q = std::uint32_t(rng() % std::uint32_t(passes));
+      ASSERT_EQ(search.delta_move(c, q), search.delta_move_reference(c, q));
+      ASSERT_EQ(search.delta_swap(c, d), search.delta_swap_reference(c, d));
+      const std::uint64_t before = search.drawn();
+      if (step % 2 == 0 && int(search.members(q).size()) < per_pass && search.pass_of()[c] != q) {
+        const std::int64_t delta = search.delta_move(c, q);
+        search.move(c, q);
+        EXPECT_EQ(std::int64_t(search.drawn()) - std::int64_t(before), delta);
+      } else if (search.pass_of()[c] != search.pass_of()[d]) {
+        search.swap(c, d);
+      }
+      ASSERT_EQ(search.drawn(), cpca::triangles_drawn(inc, search.pass_of()))
+          << "seed " << seed << " step " << step;
+    }
+  }
+}
+
 TEST(SuperclusterStrategies, OnePassDrawsEveryTriangleOnce) {
   for (std::uint32_t seed = 0; seed < 10; ++seed) {
     const int k = 1 + int(seed * 3);

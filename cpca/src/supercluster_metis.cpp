@@ -81,7 +81,7 @@ SuperClusters group_metis(const ClusterIncidence& inc, int per_pass, const Metis
   pass_of = repair_capacity(inc, per_pass, metis_parts(inc, parts, options.seed), parts);
   if (!options.refine) return groups_from_pass_of(pass_of);
   GroupingLocalSearch search(inc, per_pass, std::move(pass_of), parts);
-  search.descend();
+  search.descend_fully();
   return search.groups();
 }
 

@@ -41,9 +41,23 @@ GroupingLocalSearch::GroupingLocalSearch(const ClusterIncidence& incidence, int 
       throw std::logic_error("GroupingLocalSearch: a pass holds " + std::to_string(m.size()) +
                              " clusters, capacity " + std::to_string(per_pass_));
   drawn_ = triangles_drawn(*inc_, pass_of_);
+  pull_.assign(pass_of_.size() * members_.size(), 0);
+  for (const ClusterHyperedge& h : inc_->hyperedges) {
+    const int n = h.size();
+    for (int j = 0; j < n; ++j) {
+      std::uint32_t seen[2];
+      int count = 0;
+      for (int l = 0; l < n; ++l) {
+        if (l == j) continue;
+        const std::uint32_t q = pass_of_[h.clusters[l]];
+        if (std::find(seen, seen + count, q) == seen + count) seen[count++] = q;
+      }
+      for (int l = 0; l < count; ++l) pull(h.clusters[j], seen[l]) += h.weight;
+    }
+  }
 }
 
-std::int64_t GroupingLocalSearch::delta_move(std::uint32_t c, std::uint32_t q) const {
+std::int64_t GroupingLocalSearch::delta_move_reference(std::uint32_t c, std::uint32_t q) const {
   const std::uint32_t p = pass_of_[c];
   std::int64_t delta = 0;
   for (std::uint32_t i = inc_->edge_offset[c]; i < inc_->edge_offset[c + 1]; ++i) {
@@ -54,7 +68,7 @@ std::int64_t GroupingLocalSearch::delta_move(std::uint32_t c, std::uint32_t q) c
   return delta;
 }
 
-std::int64_t GroupingLocalSearch::delta_swap(std::uint32_t c, std::uint32_t d) const {
+std::int64_t GroupingLocalSearch::delta_swap_reference(std::uint32_t c, std::uint32_t d) const {
   const std::uint32_t p = pass_of_[c], q = pass_of_[d];
   std::int64_t delta = 0;
   const auto edge_delta = [&](const ClusterHyperedge& h) {
@@ -70,34 +84,76 @@ std::int64_t GroupingLocalSearch::delta_swap(std::uint32_t c, std::uint32_t d) c
   return delta;
 }
 
+std::int64_t GroupingLocalSearch::delta_move(std::uint32_t c, std::uint32_t q) const {
+  return std::int64_t(pull(c, pass_of_[c])) - std::int64_t(pull(c, q));
+}
+
+// A swap is the two single moves plus, on hyperedges holding both c and d, the difference
+// between the joint change and the two single-move changes (each single move assumed the
+// other cluster stayed put).
+std::int64_t GroupingLocalSearch::shared_correction(std::uint32_t c, std::uint32_t d) const {
+  const std::uint32_t p = pass_of_[c], q = pass_of_[d];
+  std::int64_t correction = 0;
+  for (std::uint32_t i = inc_->edge_offset[c]; i < inc_->edge_offset[c + 1]; ++i) {
+    const ClusterHyperedge& h = inc_->hyperedges[inc_->edge_index[i]];
+    if (!contains(h, d)) continue;
+    const int now = distinct_with(h, pass_of_, c, p, d, q);
+    const int swapped = distinct_with(h, pass_of_, c, q, d, p);
+    const int c_moved = distinct_with(h, pass_of_, c, q, d, q);
+    const int d_moved = distinct_with(h, pass_of_, c, p, d, p);
+    correction += std::int64_t(h.weight) * ((swapped - now) - (c_moved - now) - (d_moved - now));
+  }
+  return correction;
+}
+
+std::int64_t GroupingLocalSearch::delta_swap(std::uint32_t c, std::uint32_t d) const {
+  const std::uint32_t p = pass_of_[c], q = pass_of_[d];
+  return std::int64_t(pull(c, p)) - std::int64_t(pull(c, q)) + std::int64_t(pull(d, q)) -
+         std::int64_t(pull(d, p)) + shared_correction(c, d);
+}
+
+void GroupingLocalSearch::relocate(std::uint32_t x, std::uint32_t b) {
+  const std::uint32_t a = pass_of_[x];
+  if (a == b) return;
+  // For every other cluster y of x's hyperedges, pass a stops and pass b starts pulling y
+  // through x, unless the hyperedge's third cluster already pulls from that pass.
+  for (std::uint32_t i = inc_->edge_offset[x]; i < inc_->edge_offset[x + 1]; ++i) {
+    const ClusterHyperedge& h = inc_->hyperedges[inc_->edge_index[i]];
+    const int n = h.size();
+    for (int j = 0; j < n; ++j) {
+      const std::uint32_t y = h.clusters[j];
+      if (y == x) continue;
+      std::uint32_t third_pass = ClusterHyperedge::kNone;
+      for (int l = 0; l < n; ++l)
+        if (h.clusters[l] != x && h.clusters[l] != y) third_pass = pass_of_[h.clusters[l]];
+      if (third_pass != a) pull(y, a) -= h.weight;
+      if (third_pass != b) pull(y, b) += h.weight;
+    }
+  }
+  auto& from = members_[a];
+  from.erase(std::find(from.begin(), from.end(), x));
+  members_[b].push_back(x);
+  pass_of_[x] = b;
+}
+
 void GroupingLocalSearch::move(std::uint32_t c, std::uint32_t q) {
   if (int(members_[q].size()) >= per_pass_)
     throw std::logic_error("GroupingLocalSearch::move: pass " + std::to_string(q) + " is full");
   drawn_ = std::uint64_t(std::int64_t(drawn_) + delta_move(c, q));
-  auto& from = members_[pass_of_[c]];
-  from.erase(std::find(from.begin(), from.end(), c));
-  members_[q].push_back(c);
-  pass_of_[c] = q;
+  relocate(c, q);
 }
 
 void GroupingLocalSearch::swap(std::uint32_t c, std::uint32_t d) {
   drawn_ = std::uint64_t(std::int64_t(drawn_) + delta_swap(c, d));
   const std::uint32_t p = pass_of_[c], q = pass_of_[d];
-  *std::find(members_[p].begin(), members_[p].end(), c) = d;
-  *std::find(members_[q].begin(), members_[q].end(), d) = c;
-  pass_of_[c] = q;
-  pass_of_[d] = p;
+  relocate(c, q);
+  relocate(d, p);
 }
 
 void GroupingLocalSearch::affected(std::uint32_t c, std::uint32_t old_pass,
                                    std::vector<std::uint32_t>& out) const {
-  for (std::uint32_t pass : {old_pass, pass_of_[c]}) {
-    for (std::uint32_t m : members_[pass]) {
-      out.push_back(m);
-      for (std::uint32_t i = inc_->neighbor_offset[m]; i < inc_->neighbor_offset[m + 1]; ++i)
-        out.push_back(inc_->neighbor[i]);
-    }
-  }
+  for (std::uint32_t pass : {old_pass, pass_of_[c]})
+    for (std::uint32_t m : members_[pass]) out.push_back(m);
   out.push_back(c);
   for (std::uint32_t i = inc_->neighbor_offset[c]; i < inc_->neighbor_offset[c + 1]; ++i)
     out.push_back(inc_->neighbor[i]);
@@ -112,6 +168,7 @@ int GroupingLocalSearch::descend(std::vector<std::uint32_t> worklist) {
   for (std::uint32_t k : worklist)
     if (!queued[k]) queued[k] = 1, queue.push_back(k);
   std::vector<std::uint32_t> tried_passes, more;
+  std::vector<char> is_neighbor(k_count, 0);  // of the cluster being examined
   int steps = 0;
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const std::uint32_t c = queue[head];
@@ -121,7 +178,10 @@ int GroupingLocalSearch::descend(std::vector<std::uint32_t> worklist) {
     std::int64_t best = 0;
     std::uint32_t best_pass = 0, best_partner = ClusterHyperedge::kNone;
     bool found = false;
-    for (std::uint32_t i = inc_->neighbor_offset[c]; i < inc_->neighbor_offset[c + 1]; ++i) {
+    const std::uint32_t first = inc_->neighbor_offset[c], last = inc_->neighbor_offset[c + 1];
+    for (std::uint32_t i = first; i < last; ++i) is_neighbor[inc_->neighbor[i]] = 1;
+    const std::int64_t pull_here = pull(c, p);
+    for (std::uint32_t i = first; i < last; ++i) {
       const std::uint32_t q = pass_of_[inc_->neighbor[i]];
       if (q == p || std::find(tried_passes.begin(), tried_passes.end(), q) != tried_passes.end())
         continue;
@@ -130,11 +190,15 @@ int GroupingLocalSearch::descend(std::vector<std::uint32_t> worklist) {
         const std::int64_t d = delta_move(c, q);
         if (d < best) best = d, best_pass = q, best_partner = ClusterHyperedge::kNone, found = true;
       }
+      // delta_swap inlined: only neighbours can share hyperedges with c.
+      const std::int64_t c_part = pull_here - std::int64_t(pull(c, q));
       for (std::uint32_t partner : members_[q]) {
-        const std::int64_t d = delta_swap(c, partner);
+        std::int64_t d = c_part + std::int64_t(pull(partner, q)) - std::int64_t(pull(partner, p));
+        if (is_neighbor[partner]) d += shared_correction(c, partner);
         if (d < best) best = d, best_pass = q, best_partner = partner, found = true;
       }
     }
+    for (std::uint32_t i = first; i < last; ++i) is_neighbor[inc_->neighbor[i]] = 0;
     if (!found) continue;
     ++steps;
     more.clear();
@@ -156,10 +220,16 @@ int GroupingLocalSearch::descend(std::vector<std::uint32_t> worklist) {
   return steps;
 }
 
+int GroupingLocalSearch::descend_fully() {
+  int total = 0;
+  for (int steps = descend(); steps > 0; steps = descend()) total += steps;
+  return total;
+}
+
 SuperClusters refine_grouping(const ClusterIncidence& incidence, int per_pass,
                               const SuperClusters& start) {
   GroupingLocalSearch search(incidence, per_pass, start.pass_of, int(start.passes.size()));
-  search.descend();
+  search.descend_fully();
   return search.groups();
 }
 

@@ -15,7 +15,7 @@ namespace {
 GroupingLocalSearch descended(const ClusterIncidence& inc, int per_pass, int passes,
                               const SuperClusters& start) {
   GroupingLocalSearch search(inc, per_pass, start.pass_of, passes);
-  search.descend();
+  search.descend_fully();
   return search;
 }
 
@@ -76,6 +76,7 @@ SuperClusters group_search(const ClusterIncidence& inc, int per_pass,
       if (current.drawn() < best_found.drawn()) best_found = current;
     }
   }
+  best_found.descend_fully();  // the cheap worklist descents may stop short of an optimum
   return best_found.groups();
 }
 

@@ -30,8 +30,13 @@ class GroupingLocalSearch {
   int per_pass() const { return per_pass_; }
 
   // Change in triangles drawn if cluster c moved to pass q / if c and d traded passes.
+  // O(1) from the pull table (plus c's hyperedges shared with d, for a swap).
   std::int64_t delta_move(std::uint32_t c, std::uint32_t q) const;
   std::int64_t delta_swap(std::uint32_t c, std::uint32_t d) const;
+  // The slow, obvious references: recount c's (and d's) hyperedges. Tests hold the fast
+  // versions to them.
+  std::int64_t delta_move_reference(std::uint32_t c, std::uint32_t q) const;
+  std::int64_t delta_swap_reference(std::uint32_t c, std::uint32_t d) const;
   // Apply them (no capacity check beyond an always-on one for moves).
   void move(std::uint32_t c, std::uint32_t q);
   void swap(std::uint32_t c, std::uint32_t d);
@@ -40,9 +45,15 @@ class GroupingLocalSearch {
   // re-examining the neighbourhood of every change, until no step improves. Returns the
   // number of steps applied.
   int descend(std::vector<std::uint32_t> worklist = {});
+  // Full descend() sweeps until one applies nothing: a true local optimum for moves and
+  // swaps. Returns the steps applied.
+  int descend_fully();
 
-  // Clusters whose best step may have changed after c changed pass: c, the members of
-  // its old and new pass and all their neighbours. Appended to `out`.
+  // Clusters to re-examine after c changed pass: c, its neighbours (their deltas changed)
+  // and the members of its old and new pass (their room and partners changed). Appended to
+  // `out`. A cluster elsewhere whose best swap partner is now c is not re-examined, so
+  // descend() ends at a local optimum only for a full worklist; refine_grouping() therefore
+  // repeats full sweeps until one finds nothing.
   void affected(std::uint32_t c, std::uint32_t old_pass, std::vector<std::uint32_t>& out) const;
 
   SuperClusters groups() const { return groups_from_pass_of(pass_of_); }
@@ -53,6 +64,17 @@ class GroupingLocalSearch {
   std::vector<std::uint32_t> pass_of_;
   std::vector<std::vector<std::uint32_t>> members_;
   std::uint64_t drawn_ = 0;
+  // pull_[c * passes + q]: triangles of c that have another vertex in a cluster of pass q.
+  // Cluster c in pass q draws its multi-cluster triangles (constant) - pull(c, q) times
+  // fewer, so delta_move(c, q) = pull(c, p) - pull(c, q): the thesis's "overdraw reduced by
+  // the clusters already chosen", kept up to date for every pass at once.
+  std::vector<std::uint32_t> pull_;
+  std::uint32_t& pull(std::uint32_t c, std::uint32_t q) { return pull_[c * members_.size() + q]; }
+  std::uint32_t pull(std::uint32_t c, std::uint32_t q) const {
+    return pull_[c * members_.size() + q];
+  }
+  void relocate(std::uint32_t c, std::uint32_t q);  // pass_of_, members_, pull_; not drawn_
+  std::int64_t shared_correction(std::uint32_t c, std::uint32_t d) const;
 };
 
 // Local search from `start` (a grouping of the incidence's clusters); the result is never
