@@ -45,19 +45,6 @@ FileKind detect_kind(const std::string& path) {
                                                             : FileKind::kTransfer;
 }
 
-// The .prtx header's payload_checksum (docs/FORMATS.md, offset 104), which a compressed file
-// records as its transfer_hash. Read after prt::read_transfer_header has checked the header
-// (and its checksum), so the value can be trusted without hashing a payload of a gigabyte.
-std::uint64_t transfer_payload_checksum(const std::string& path) {
-  constexpr std::streamoff kOffPayloadChecksum = 104;
-  std::ifstream in(path, std::ios::binary);
-  std::uint64_t checksum = 0;
-  in.seekg(kOffPayloadChecksum);
-  in.read(reinterpret_cast<char*>(&checksum), sizeof checksum);
-  if (!in) throw std::runtime_error(path + ": cannot read its payload checksum; check the file");
-  return checksum;
-}
-
 void print_status(bool current, const std::string& against) {
   std::printf("status      %s against %s\n", current ? "current" : "STALE", against.c_str());
 }
@@ -140,10 +127,9 @@ void describe_compressed(const std::string& path, const std::string& mesh,
   }
   if (!transfer.empty()) {
     const prt::TransferSet t = prt::read_transfer_header(transfer);
-    const bool current = transfer_payload_checksum(transfer) == set.transfer_hash &&
-                         t.mesh_hash == set.mesh_hash && t.vertex_count == set.vertex_count &&
-                         t.order == set.order && t.channels == set.channels &&
-                         t.columns() == set.columns;
+    const bool current = t.payload_checksum == set.transfer_hash && t.mesh_hash == set.mesh_hash &&
+                         t.vertex_count == set.vertex_count && t.order == set.order &&
+                         t.channels == set.channels && t.columns() == set.columns;
     print_status(current, transfer);
     if (!current && stale.empty()) {
       stale = path + " was compressed from a different bake than " + transfer +

@@ -319,6 +319,7 @@ TransferSet read(const fs::path& path, bool with_payload) {
   set.vertex_count = f.vertex_count;
   set.seed = get<std::uint64_t>(h, kOffSeed);
   set.mesh_hash = get<std::uint64_t>(h, kOffMeshHash);
+  set.payload_checksum = get<std::uint64_t>(h, kOffPayloadChecksum);
   set.material.kind = static_cast<MaterialKind>(f.material_kind);
   set.material.albedo = Eigen::Vector3f(f.albedo[0], f.albedo[1], f.albedo[2]);
   set.material.specular = f.specular;

@@ -34,7 +34,7 @@ struct CompressOptions {
   bool overdraw_reduction = false;  // needs geometry
   OverdrawReductionOptions overdraw;
   std::uint64_t seed = 1;
-  double lbg_threshold = 1e-4;  // converged ratio (thesis eq. 5)
+  double lbg_threshold = 1e-3;  // converged ratio (thesis eq. 5)
   int lbg_max_iterations = 200;
   double cpca_threshold = 1e-4;  // iterative CPCA stops when the error falls less than this
   int cpca_max_iterations = 20;

@@ -23,7 +23,7 @@ namespace cpca {
 
 struct LbgOptions {
   int clusters = 256;
-  double threshold = 1e-4;  // on the converged ratio (eq. 5)
+  double threshold = 1e-3;  // on the converged ratio (eq. 5): energy falls < 0.1%
   int max_iterations = 200;
   std::uint64_t seed = 1;  // of the hyper-box initialisation
 };
