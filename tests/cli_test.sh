@@ -83,6 +83,30 @@ leftovers=$(find "$tmp" -name '*.tmp-*' | wc -l)
 ((leftovers == 0)); check "bake leaves no temporary files ($leftovers)" $?
 [[ ! -e $tmp/x.prtx ]]; check "failed bakes leave no output" $?
 
+# Compress the cube bake (8 vertices, 81 numbers each) and describe the result.
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/cube.prtc" --clusters 2 --pcs 2 -q
+expect_code 0; check "compress exits 0" $?
+[[ $(head -c 8 "$tmp/cube.prtc" 2>/dev/null) == PRTRCMPR ]]; check "compress writes a .prtc file" $?
+[[ $out =~ Average\ SE\ [0-9.e+-]+ ]]; check "compress reports the Average SE" $?
+[[ $out =~ clusters\ 2\ x\ 2\ PCs ]]; check "compress reports clusters x PCs" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/cube8.prtc" --clusters 8 --pcs 1 --json -q
+[[ $out =~ \"average_se\":0[,.] || $out =~ \"average_se\":[0-9.]+e-[1-9][0-9] ]]; check "compress: clusters = vertices gives zero error ($out)" $?
+run info "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --transfer "$tmp/cube.prtx" --verify
+expect_code 0 && [[ $out == *current* && $out != *STALE* ]]; check "info: .prtc current against its mesh and bake" $?
+run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: .prtc stale against another mesh" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 9
+expect_code 2 && [[ $err == *--clusters* ]]; check "compress: more clusters than vertices is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --pcs 81
+expect_code 2 && [[ $err == *--pcs* ]]; check "compress: PCs >= dimension is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --method kmeans; expect_code 2; check "compress: unknown method is a usage error" $?
+run compress "$tmp/missing.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc"
+expect_code 1 && [[ $err == *missing.prtx* ]]; check "compress: missing transfer exits 1 naming it" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/quad.obj" -o "$tmp/y.prtc" --clusters 2
+expect_code 1 && [[ $err == *quad.obj* ]]; check "compress: the wrong mesh exits 1 naming it" $?
+[[ ! -e $tmp/y.prtc ]]; check "failed compressions leave no output" $?
+head -c 100 "$tmp/cube.prtc" >"$tmp/short.prtc"
+run info "$tmp/short.prtc"; expect_code 1 && [[ $err == *short.prtc* ]]; check "info: truncated .prtc exits 1 naming it" $?
+
 # The real inputs, when installed.
 bunny=/usr/share/glmark2/models/bunny.obj
 if [[ -f $bunny ]]; then
