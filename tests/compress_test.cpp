@@ -232,3 +232,34 @@ TEST(Compress, RejectsBadParametersWithTheirNames) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SubspaceDistances, CandidateRestrictionAgreesWithTheFullMatrix) {
+  const cpca::DataMatrix x = affine_subspaces(6, 30, 3, 16, 9);
+  cpca::CompressOptions o;
+  o.clusters = 6;
+  o.components = 2;
+  const cpca::CompressedSet set = cpca::compress(x, o);
+  const Eigen::VectorXf norms = x.rowwise().squaredNorm();
+  const cpca::DataMatrix full = cpca::subspace_distances(x, norms, set);
+  const cpca::DataMatrix some = cpca::subspace_distances(x, norms, set, 2);
+  const cpca::DataMatrix means = Eigen::Map<const cpca::DataMatrix>(set.means.data(), 6, 16);
+  for (int p = 0; p < x.rows(); ++p) {
+    int finite = 0;
+    for (int k = 0; k < 6; ++k) {
+      if (!std::isfinite(some(p, k))) continue;
+      ++finite;
+      EXPECT_NEAR(some(p, k), full(p, k), 2e-6 * (norms[p] + full(p, k)));
+    }
+    EXPECT_GE(finite, 2);
+    EXPECT_LE(finite, 3);
+    EXPECT_TRUE(std::isfinite(some(p, int(set.cluster_of[std::size_t(p)]))));
+    // The two nearest means are among the candidates.
+    Eigen::Index nearest = 0;
+    (means.rowwise() - x.row(p)).rowwise().squaredNorm().minCoeff(&nearest);
+    EXPECT_TRUE(std::isfinite(some(p, int(nearest))));
+  }
+}
+
+}  // namespace

@@ -1,11 +1,13 @@
 #include "cpca/cluster_pca.h"
 
+#include "cpca/assignment.h"
 #include "cpca/lbg.h"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
+#include <limits>
 #include <numeric>
 
 namespace cpca {
@@ -100,6 +102,55 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
         block.col(j) -= proj.middleCols(Eigen::Index(j) * n, n).rowwise().squaredNorm();
     }
     block = block.cwiseMax(0.f);
+  });
+  return out;
+}
+
+DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
+                              const Eigen::VectorXf& x_squared_norms, const CompressedSet& set,
+                              int candidates) {
+  const int k = set.cluster_count, n = set.component_count;
+  if (candidates <= 0 || candidates >= k) return subspace_distances(x, x_squared_norms, set);
+  const Eigen::Index v = x.rows(), d = x.cols();
+  const Eigen::Map<const DataMatrix> means(set.means.data(), k, d);
+  const DataMatrix to_means = squared_distances(x, x_squared_norms, means);
+  // Candidate lists per cluster.
+  std::vector<std::vector<std::uint32_t>> points(static_cast<std::size_t>(k));
+  {
+    std::vector<std::vector<std::uint32_t>> chosen(static_cast<std::size_t>(v));
+    tbb::parallel_for(Eigen::Index(0), v, [&](Eigen::Index p) {
+      std::vector<std::uint32_t> order(static_cast<std::size_t>(k));
+      std::iota(order.begin(), order.end(), 0u);
+      std::nth_element(order.begin(), order.begin() + candidates, order.end(),
+                       [&](std::uint32_t a, std::uint32_t b) {
+                         const float da = to_means(p, a), db = to_means(p, b);
+                         return da < db || (da == db && a < b);
+                       });
+      order.resize(std::size_t(candidates));
+      const std::uint32_t current = set.cluster_of[std::size_t(p)];
+      if (std::find(order.begin(), order.end(), current) == order.end()) order.push_back(current);
+      chosen[std::size_t(p)] = std::move(order);
+    });
+    for (Eigen::Index p = 0; p < v; ++p)
+      for (std::uint32_t j : chosen[std::size_t(p)]) points[j].push_back(std::uint32_t(p));
+  }
+  DataMatrix out = DataMatrix::Constant(v, k, std::numeric_limits<float>::infinity());
+  tbb::parallel_for(0, k, [&](int j) {
+    const auto& members = points[std::size_t(j)];
+    if (members.empty()) return;
+    const Eigen::Index rows = Eigen::Index(members.size());
+    DataMatrix centred(rows, d);
+    for (Eigen::Index i = 0; i < rows; ++i)
+      centred.row(i) = x.row(members[std::size_t(i)]) - means.row(j);
+    Eigen::VectorXf residual = centred.rowwise().squaredNorm();
+    if (n > 0) {
+      const auto basis = set.basis(j);
+      const DataMatrix w = centred * basis.transpose();
+      residual -= w.rowwise().squaredNorm();
+    }
+    // Columns of `out` are written by one task each: no two tasks touch the same entry.
+    for (Eigen::Index i = 0; i < rows; ++i)
+      out(members[std::size_t(i)], j) = std::max(0.f, residual[i]);
   });
   return out;
 }

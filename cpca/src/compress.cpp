@@ -162,7 +162,7 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
     r.cpca_error.push_back(error);
     for (int it = 1; it <= options.cpca_max_iterations && error > 0; ++it) {
       notify("cpca", double(it - 1) / options.cpca_max_iterations);
-      const DataMatrix d2 = subspace_distances(data, norms, set);
+      const DataMatrix d2 = subspace_distances(data, norms, set, options.cpca_candidates);
       CompressedSet next = set;
       next.cluster_of =
           coherence ? coherence->assign(d2, set.cluster_of, std::sqrt(error / double(data.rows())))

@@ -30,6 +30,14 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
 DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
                               const Eigen::VectorXf& x_squared_norms, const CompressedSet& set);
 
+// The same restricted to candidates: for each point, its current cluster and the
+// `candidates` clusters with the nearest means; every other entry is +infinity. The nearest
+// affine subspace is almost always among the nearest means, and this costs ~K / candidates
+// times less than the full matrix (one V x K distance product plus small per-cluster ones).
+DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
+                              const Eigen::VectorXf& x_squared_norms, const CompressedSet& set,
+                              int candidates);
+
 // The same for one point and one cluster, in double.
 double subspace_distance(const Eigen::Ref<const Eigen::RowVectorXf>& x, const CompressedSet& set,
                          int cluster);

@@ -36,8 +36,11 @@ struct CompressOptions {
   std::uint64_t seed = 1;
   double lbg_threshold = 1e-3;  // converged ratio (thesis eq. 5)
   int lbg_max_iterations = 200;
-  double cpca_threshold = 1e-4;  // iterative CPCA stops when the error falls less than this
+  double cpca_threshold = 1e-3;  // iterative CPCA stops when the error falls less than this
   int cpca_max_iterations = 20;
+  // Iterative CPCA compares each point against its current cluster and this many clusters
+  // with the nearest means (0: all clusters, exact but ~K/candidates times slower).
+  int cpca_candidates = 16;
 };
 
 // Triangles whose three vertices lie in 1, 2 or 3 distinct clusters.

@@ -1,0 +1,50 @@
+// render/image.h: a float RGBA image and its EXR and PNG writers (OpenImageIO, only in
+// render/src/image.cpp).
+//
+// Pixels are linear radiance in the probe's units (DESIGN.md: tone mapping happens only when
+// writing PNG); alpha is coverage (1 where the mesh is, 0 on the background). Row 0 is the
+// top row. Both writers are atomic: a temporary file in the target's directory, renamed
+// over the target once complete.
+//
+// PNG tone map, documented here once: c = radiance * 2^exposure, then the ACES filmic curve
+// fitted by K. Narkowicz (2015), f(c) = c (2.51 c + 0.03) / (c (2.43 c + 0.59) + 0.14)
+// clamped to [0, 1], then the sRGB transfer function, then 8 bits. Alpha is dropped: the
+// PNG is a preview with its background.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+namespace render {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgba;  // width * height * 4, row-major from the top row
+
+  float* pixel(int x, int y) { return rgba.data() + (std::size_t(y) * width + x) * 4; }
+  const float* pixel(int x, int y) const { return rgba.data() + (std::size_t(y) * width + x) * 4; }
+  // Largest |R|, |G| or |B| over the image (0 for an empty image).
+  float max_rgb() const;
+};
+
+class ImageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Float RGBA EXR (channels R, G, B, A; alpha is coverage), ZIP compressed.
+void write_exr(const std::filesystem::path& path, const Image& image);
+
+// 8-bit sRGB PNG after exposure and the tone map above.
+void write_png(const std::filesystem::path& path, const Image& image, double exposure = 0.0);
+
+// The tone map above for one linear value, before quantisation (for tests and previews).
+float tone_map(float linear, double exposure);
+
+// Reads any image OpenImageIO understands into RGBA floats (missing alpha -> 1), for tests
+// and comparisons.
+Image read_image(const std::filesystem::path& path);
+
+}  // namespace render

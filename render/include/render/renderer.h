@@ -1,0 +1,139 @@
+// render/renderer.h: relights a CPCA-compressed mesh with OpenGL (OSMesa/llvmpipe) into an
+// offscreen RGBA32F + depth framebuffer. Thesis ch. 3.2 and 4.1; DESIGN.md "Rendering,
+// super-clusters, overdraw"; issue 5.
+//
+// Modes (all give the same image up to float rounding; tests hold them to it):
+//  - multipass:    depth pre-pass, then one additive pass per super-cluster with GL_EQUAL
+//                  depth. A pass binds only its clusters' constants (a UBO range within the
+//                  register budget) and draws only the triangles touching its clusters
+//                  (index buffers built once); vertices of other passes output zero, and
+//                  since interpolation is linear the passes sum to the single-pass image.
+//  - singlepass:   all clusters' constants in one SSBO, one draw; overdraw exactly 1.
+//  - decoupled:    vertices are stored sorted by (pass, cluster). Each cluster's vertices
+//                  are shaded once, as points, with that cluster's constants bound as a UBO
+//                  range (so every register index is a literal), and transform feedback
+//                  writes their radiance into one vertex buffer; then all triangles are
+//                  drawn once with a pass-through shader. Overdraw 1, every vertex shaded
+//                  once, whatever the budget.
+//  - uncompressed: per-vertex exit vectors e_p = M_p l from the transfer set (CPU GEMMs,
+//                  uploaded as an SSBO), SH evaluated in the vertex shader.
+//  - cpu:          the per-vertex radiance computed on the CPU from the same constants
+//                  (render/shading.h), drawn with a pass-through shader.
+// Lighting: the renderer takes the unrotated SH lighting l and the environment rotation R;
+// per frame it computes D(R) l (no re-projection) and the constants, in parallel.
+// Background: the probe rotated by R (radiance toward w is probe(R^T w)) or a solid colour.
+// Alpha is coverage. Back faces are culled by default (closed meshes; see the options).
+#pragma once
+
+#include "cpca/compressed.h"
+#include "cpca/supercluster.h"
+#include "meshes/mesh.h"
+#include "probes/probe.h"
+#include "prt/projection.h"
+#include "prt/transfer.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/shading.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace render {
+
+enum class Mode { kMultipass, kSinglepass, kDecoupled, kUncompressed, kCpu };
+const char* mode_name(Mode mode);  // "multipass", ...
+// Throws std::invalid_argument listing the valid names.
+Mode parse_mode(const std::string& name);
+
+struct RendererOptions {
+  Mode mode = Mode::kMultipass;
+  // vec4 registers a pass may use; 0 = what the context offers (the smaller of
+  // GL_MAX_VERTEX_UNIFORM_VECTORS and GL_MAX_UNIFORM_BLOCK_SIZE / 16).
+  int register_budget = 0;
+  // Clusters per pass; 0 = as many as the budget holds. More than the budget holds is an error.
+  int clusters_per_pass = 0;
+  // The grouping of clusters into passes (a strategy's output, cpca/supercluster.h); when
+  // empty, passes are filled in cluster order.
+  std::optional<cpca::SuperClusters> groups;
+  bool cull_back_faces = true;        // halves raster cost; closed meshes only
+  bool optimize_vertex_cache = true;  // meshoptimizer order per index buffer
+  bool count_primitives = false;      // GL_PRIMITIVES_GENERATED query per pass (slower)
+};
+
+struct Background {
+  bool use_probe = true;  // else the solid colour
+  Rgb colour = Rgb::Zero();
+};
+
+struct FrameTiming {
+  double cpu_ms = 0;    // rotation, constants, per-vertex CPU work, buffer uploads
+  double gl_ms = 0;     // draw calls until glFinish returns
+  double total_ms = 0;  // the frame
+};
+
+struct RenderStats {
+  int register_budget = 0;
+  int registers_per_cluster = 0;
+  int clusters_per_pass = 0;
+  int passes = 1;                                 // shading passes (draws over triangles)
+  std::vector<std::uint64_t> triangles_per_pass;  // predicted from cluster ids and grouping
+  std::vector<std::uint64_t> measured_triangles;  // GL queries of the last frame (if enabled)
+  double average_overdraw = 1.0;
+  std::uint64_t triangle_count = 0;
+  std::uint64_t vertex_count = 0;
+};
+
+class Renderer {
+ public:
+  // Needs a current GL 4.5 context (render/gl_context.h). The mesh needs frames. `set` is
+  // required for every mode but uncompressed, `transfer` for uncompressed; both must match
+  // the mesh's vertex count. `probe` (may be null: black) is the background and is kept by
+  // reference only during construction (uploaded as a texture).
+  Renderer(const meshes::Mesh& mesh, const cpca::CompressedSet* set,
+           const prt::TransferSet* transfer, const probes::Probe* probe,
+           const RendererOptions& options);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  void set_background(const Background& background);
+
+  // Draws one frame (waits for it with glFinish) and returns its timing.
+  FrameTiming render(const Camera& camera, const Eigen::Ref<const prt::ShLighting>& lighting,
+                     const Eigen::Matrix3d& rotation);
+  // The framebuffer of the last frame; row 0 at the top.
+  Image read_image() const;
+
+  // The per-vertex radiance the mode's vertex stage produces (transform feedback for the GL
+  // shading paths), in the mesh's vertex order; for multipass the sum over passes.
+  std::vector<Rgb> capture_vertex_radiance(const Camera& camera,
+                                           const Eigen::Ref<const prt::ShLighting>& lighting,
+                                           const Eigen::Matrix3d& rotation);
+
+  const RenderStats& stats() const;
+  Mode mode() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The median-of-frames measurement of issue 5: `warmup` frames, then `frames` frames, each
+// with the environment rotated by `degrees_per_frame` more about `axis` (so constants are
+// recomputed every frame, inside the timing), each ended by glFinish.
+struct TimingSummary {
+  int frames = 0;
+  double frame_ms_median = 0, cpu_ms_median = 0, gl_ms_median = 0;
+  double fps = 0;  // 1000 / frame_ms_median
+};
+TimingSummary measure(Renderer& renderer, const Camera& camera,
+                      const Eigen::Ref<const prt::ShLighting>& lighting,
+                      const Eigen::Matrix3d& start_rotation, const Eigen::Vector3d& axis,
+                      double degrees_per_frame, int frames, int warmup);
+
+}  // namespace render

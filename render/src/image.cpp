@@ -1,0 +1,109 @@
+#include "render/image.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <system_error>
+
+namespace render {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// Writes through OpenImageIO to a hidden temporary name with the target's extension (OIIO
+// picks the format from it), then renames; the temporary is removed on any failure.
+void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const void* data,
+                      const char* what) {
+  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir))
+    throw ImageError(std::string("cannot write ") + what + " " + path.string() + ": directory " +
+                     dir.string() + " does not exist; create it first");
+  std::random_device rd;
+  std::string name = ".";
+  name += path.stem().string();
+  name += ".tmp";
+  name += std::to_string(rd() % 1000000);
+  name += path.extension().string();
+  const fs::path temp = dir / name;
+  auto fail = [&](const std::string& why) {
+    std::error_code ec;
+    fs::remove(temp, ec);
+    throw ImageError(std::string("cannot write ") + what + " " + path.string() + ": " + why);
+  };
+  auto out = OIIO::ImageOutput::create(temp.string());
+  if (!out) fail("no OpenImageIO writer for extension '" + path.extension().string() + "'");
+  if (!out->open(temp.string(), spec)) fail(out->geterror());
+  if (!out->write_image(spec.format, data)) fail(out->geterror());
+  if (!out->close()) fail(out->geterror());
+  std::error_code ec;
+  fs::rename(temp, path, ec);
+  if (ec) fail("rename failed: " + ec.message());
+}
+
+float srgb_encode(float v) {
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace
+
+float Image::max_rgb() const {
+  float m = 0.f;
+  for (std::size_t i = 0; i < rgba.size(); i += 4)
+    for (int c = 0; c < 3; ++c) m = std::max(m, std::abs(rgba[i + c]));
+  return m;
+}
+
+float tone_map(float linear, double exposure) {
+  const float c = std::max(0.f, float(double(linear) * std::exp2(exposure)));
+  const float f = c * (2.51f * c + 0.03f) / (c * (2.43f * c + 0.59f) + 0.14f);
+  return srgb_encode(std::clamp(f, 0.f, 1.f));
+}
+
+void write_exr(const std::filesystem::path& path, const Image& image) {
+  if (image.width < 1 || image.height < 1 ||
+      image.rgba.size() != std::size_t(image.width) * image.height * 4)
+    throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
+  OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = {"R", "G", "B", "A"};
+  spec.alpha_channel = 3;
+  spec.attribute("compression", "zip");
+  write_atomically(path, spec, image.rgba.data(), "EXR");
+}
+
+void write_png(const std::filesystem::path& path, const Image& image, double exposure) {
+  if (image.width < 1 || image.height < 1 ||
+      image.rgba.size() != std::size_t(image.width) * image.height * 4)
+    throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
+  std::vector<std::uint8_t> rgb(std::size_t(image.width) * image.height * 3);
+  for (std::size_t p = 0; p < std::size_t(image.width) * image.height; ++p)
+    for (int c = 0; c < 3; ++c)
+      rgb[p * 3 + c] = std::uint8_t(std::lround(255.f * tone_map(image.rgba[p * 4 + c], exposure)));
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  write_atomically(path, spec, rgb.data(), "PNG");
+}
+
+Image read_image(const std::filesystem::path& path) {
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in)
+    throw ImageError("cannot read image " + path.string() + ": " + OIIO::geterror() +
+                     " (check the path and that it is an image file)");
+  const OIIO::ImageSpec& spec = in->spec();
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  std::vector<float> all(std::size_t(spec.width) * spec.height * spec.nchannels);
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+    throw ImageError("cannot read image " + path.string() + ": " + in->geterror());
+  image.rgba.assign(std::size_t(spec.width) * spec.height * 4, 1.f);
+  for (std::size_t p = 0; p < std::size_t(spec.width) * spec.height; ++p)
+    for (int c = 0; c < std::min(4, spec.nchannels); ++c)
+      image.rgba[p * 4 + c] = all[p * spec.nchannels + c];
+  return image;
+}
+
+}  // namespace render

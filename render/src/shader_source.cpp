@@ -1,0 +1,238 @@
+#include "render/shader_source.h"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace render {
+
+namespace {
+
+const char* kHeader = "#version 450 core\n";
+const char* kPositionDecl =
+    "layout(location = 0) in vec3 a_position;\n"
+    "uniform mat4 u_clip_from_world;\n"
+    "invariant gl_Position;\n";
+const char* kPositionStatement = "  gl_Position = u_clip_from_world * vec4(a_position, 1.0);\n";
+
+// Shortest text that reads back as the same float.
+std::string literal(double value) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.9g", value);
+  std::string s(buf);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+double factorial_ratio(int l, int m) {  // (l - m)! / (l + m)!
+  double r = 1.0;
+  for (int i = l - m + 1; i <= l + m; ++i) r /= double(i);
+  return r;
+}
+
+// Local view direction in the vertex frame, as `d`.
+const char* kLocalView =
+    "  vec3 n_ = normalize(a_normal);\n"
+    "  vec3 t_ = normalize(a_tangent);\n"
+    "  vec3 b_ = cross(n_, t_);\n"
+    "  vec3 v_ = normalize(u_eye - a_position);\n"
+    "  vec3 d = vec3(dot(v_, t_), dot(v_, b_), dot(v_, n_));\n";
+
+}  // namespace
+
+std::string sh_basis_glsl(int order, const std::string& dir, const std::string& prefix) {
+  if (order < 1 || order > 10)
+    throw std::invalid_argument("sh_basis_glsl: order " + std::to_string(order) +
+                                " is outside 1..10");
+  std::ostringstream o;
+  const std::string x = dir + ".x", y = dir + ".y", z = dir + ".z";
+  // Re/Im of (x + i y)^m carry sin^m(theta) cos/sin(m phi), so no trigonometry is needed.
+  o << "  float c0_ = 1.0, s0_ = 0.0;\n";
+  for (int m = 1; m < order; ++m) {
+    o << "  float c" << m << "_ = " << x << " * c" << m - 1 << "_ - " << y << " * s" << m - 1
+      << "_;\n";
+    o << "  float s" << m << "_ = " << x << " * s" << m - 1 << "_ + " << y << " * c" << m - 1
+      << "_;\n";
+  }
+  for (int m = 0; m < order; ++m) {
+    // P~_l^m(z): associated Legendre without sin^m(theta) and without the (-1)^m phase.
+    double pmm = 1.0;
+    for (int k = 1; k <= m; ++k) pmm *= double(2 * k - 1);
+    auto p = [&](int l) {
+      std::string name = "p";
+      name += std::to_string(l);
+      name += '_';
+      name += std::to_string(m);
+      name += '_';
+      return name;
+    };
+    o << "  float " << p(m) << " = " << literal(pmm) << ";\n";
+    if (m + 1 < order)
+      o << "  float " << p(m + 1) << " = " << literal(2 * m + 1) << " * " << z << " * " << p(m)
+        << ";\n";
+    for (int l = m + 2; l < order; ++l)
+      o << "  float " << p(l) << " = " << literal(double(2 * l - 1) / (l - m)) << " * " << z
+        << " * " << p(l - 1) << " - " << literal(double(l + m - 1) / (l - m)) << " * " << p(l - 2)
+        << ";\n";
+    for (int l = m; l < order; ++l) {
+      const double k = std::sqrt((2 * l + 1) / (4 * std::numbers::pi) * factorial_ratio(l, m));
+      if (m == 0) {
+        o << "  float " << prefix << l * (l + 1) << " = " << literal(k) << " * " << p(l) << ";\n";
+      } else {
+        const std::string scale = literal(std::numbers::sqrt2 * k);
+        o << "  float " << prefix << l * (l + 1) + m << " = " << scale << " * " << p(l) << " * c"
+          << m << "_;\n";
+        o << "  float " << prefix << l * (l + 1) - m << " = " << scale << " * " << p(l) << " * s"
+          << m << "_;\n";
+      }
+    }
+  }
+  return o.str();
+}
+
+std::string compressed_vertex_shader(const ConstantLayout& layout, ConstantAccess access, int slots,
+                                     bool pass_test) {
+  const int registers = layout.registers_per_cluster();
+  const int components = layout.terms - 1;
+  const int weight_vectors = (components + 3) / 4;
+  std::ostringstream o;
+  o << kHeader << kPositionDecl;
+  o << "layout(location = 1) in vec3 a_normal;\n"
+       "layout(location = 2) in vec3 a_tangent;\n"
+       "layout(location = 3) in uint a_cluster;\n"
+       "layout(location = 4) in uint a_pass;\n";
+  for (int i = 0; i < weight_vectors; ++i)
+    o << "layout(location = " << kAttrWeights + i << ") in vec4 a_w" << i << ";\n";
+  o << "uniform vec3 u_eye;\nuniform uint u_pass;\n";
+  std::string base;
+  if (access == ConstantAccess::kStorage) {
+    o << "layout(std430, binding = " << kConstantsBinding
+      << ") readonly buffer Constants { vec4 k_[]; };\n";
+    base = "base_ + ";
+  } else {
+    const int count = registers * (access == ConstantAccess::kUniformFixed ? 1 : slots);
+    o << "layout(std140, binding = " << kConstantsBinding << ") uniform Constants { vec4 k_["
+      << count << "]; };\n";
+    if (access == ConstantAccess::kUniformSlot) base = "base_ + ";
+  }
+  o << "out vec3 v_radiance;\n\nvoid main() {\n" << kPositionStatement;
+  if (pass_test) o << "  if (a_pass != u_pass) { v_radiance = vec3(0.0); return; }\n";
+  if (!base.empty()) o << "  int base_ = int(a_cluster) * " << registers << ";\n";
+  if (layout.glossy) {
+    o << kLocalView << sh_basis_glsl(layout.order, "d", "y");
+  } else {
+    o << "  float y0 = 1.0;\n";
+  }
+  static const char kComp[] = "xyzw";
+  o << "  vec3 r = vec3(0.0);\n";
+  for (int t = 0; t < layout.terms; ++t) {
+    std::string weight;
+    if (t > 0) weight = "a_w" + std::to_string((t - 1) / 4) + "." + kComp[(t - 1) % 4];
+    o << "  r += ";
+    if (!weight.empty()) o << weight << " * ";
+    o << "vec3(";
+    for (int c = 0; c < 3; ++c) {
+      if (c) o << ",\n       ";
+      for (int i = 0; i < layout.rows; ++i) {
+        const int f = layout.offset(t, c, i);
+        if (i) o << " + ";
+        o << "y" << i << " * k_[" << base << f / 4 << "]." << kComp[f % 4];
+      }
+    }
+    o << ");\n";
+  }
+  o << "  v_radiance = r;\n}\n";
+  return o.str();
+}
+
+std::string uncompressed_vertex_shader(int order, bool glossy) {
+  const int rows = glossy ? order * order : 1;
+  std::ostringstream o;
+  o << kHeader << kPositionDecl
+    << "layout(location = 1) in vec3 a_normal;\n"
+       "layout(location = 2) in vec3 a_tangent;\n"
+       "uniform vec3 u_eye;\n"
+       "layout(std430, binding = "
+    << kExitBinding
+    << ") readonly buffer Exit { float e_[]; };\n"
+       "out vec3 v_radiance;\n\nvoid main() {\n"
+    << kPositionStatement << "  int base_ = gl_VertexID * " << 3 * rows << ";\n";
+  if (glossy)
+    o << kLocalView << sh_basis_glsl(order, "d", "y");
+  else
+    o << "  float y0 = 1.0;\n";
+  o << "  v_radiance = vec3(";
+  for (int c = 0; c < 3; ++c) {
+    if (c) o << ",\n      ";
+    for (int i = 0; i < rows; ++i)
+      o << (i ? " + " : "") << "y" << i << " * e_[base_ + " << c * rows + i << "]";
+  }
+  o << ");\n}\n";
+  return o.str();
+}
+
+std::string passthrough_vertex_shader() {
+  return std::string(kHeader) + kPositionDecl +
+         "layout(location = 15) in vec3 a_radiance;\n"
+         "out vec3 v_radiance;\n\nvoid main() {\n" +
+         kPositionStatement + "  v_radiance = a_radiance;\n}\n";
+}
+
+std::string position_vertex_shader() {
+  return std::string(kHeader) + kPositionDecl + "\nvoid main() {\n" + kPositionStatement + "}\n";
+}
+
+std::string radiance_fragment_shader() {
+  return std::string(kHeader) +
+         "in vec3 v_radiance;\nlayout(location = 0) out vec4 o_colour;\n"
+         "void main() { o_colour = vec4(v_radiance, 1.0); }\n";
+}
+
+std::string coverage_fragment_shader() {
+  return std::string(kHeader) +
+         "layout(location = 0) out vec4 o_colour;\n"
+         "void main() { o_colour = vec4(0.0, 0.0, 0.0, 1.0); }\n";
+}
+
+std::string constant_fragment_shader() {
+  return std::string(kHeader) +
+         "uniform vec3 u_colour;\nlayout(location = 0) out vec4 o_colour;\n"
+         "void main() { o_colour = vec4(u_colour, 1.0); }\n";
+}
+
+std::string background_vertex_shader() {
+  return std::string(kHeader) +
+         "void main() {\n"
+         "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
+         "  gl_Position = vec4(p, 1.0, 1.0);\n"
+         "}\n";
+}
+
+std::string background_fragment_shader() {
+  return std::string(kHeader) +
+         "uniform vec3 u_forward, u_right, u_up;  // right/up scaled by the half-fov tangents\n"
+         "uniform vec2 u_viewport;\n"
+         "uniform mat3 u_probe_from_world;\n"
+         "uniform int u_solid;\n"
+         "uniform vec3 u_colour;\n"
+         "uniform sampler2D u_probe;\n"
+         "layout(location = 0) out vec4 o_colour;\n"
+         "const float kPi = 3.14159265358979;\n"
+         "void main() {\n"
+         "  if (u_solid != 0) { o_colour = vec4(u_colour, 0.0); return; }\n"
+         "  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;\n"
+         "  vec3 w = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);\n"
+         "  vec3 d = normalize(u_probe_from_world * w);\n"
+         "  // probes/probe.h: direction(u, v) = (-sin t sin p, cos t, sin t cos p).\n"
+         "  float theta = acos(clamp(d.y, -1.0, 1.0));\n"
+         "  float phi = atan(-d.x, d.z);\n"
+         "  if (phi < 0.0) phi += 2.0 * kPi;\n"
+         "  o_colour = vec4(texture(u_probe, vec2(phi / (2.0 * kPi), theta / kPi)).rgb, 0.0);\n"
+         "}\n";
+}
+
+}  // namespace render

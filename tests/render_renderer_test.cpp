@@ -1,0 +1,387 @@
+// The renderer's modes against the CPU reference and against each other, on small baked
+// meshes and small images. The oracles: render/shading.h's reference (reconstruct each
+// vertex in double, evaluate prt::sh_eval), cpca::overdraw for the triangle counts, Probe's
+// own lookup for the background, and the rotation symmetry of an unoccluded sphere.
+#include "render/renderer.h"
+
+#include "cpca/supercluster.h"
+#include "meshes/procedural.h"
+#include "probes/procedural.h"
+#include "prt/bake.h"
+#include "prt/sh_rotation.h"
+#include "render/gl_context.h"
+
+#include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+namespace {
+
+// GL float sums of ~300 products against double: rounding stays near 1e-6 of the largest
+// radiance; 1e-4 is the bound and leaves room for llvmpipe's fused multiply-adds.
+constexpr double kVertexTolerance = 1e-4;
+// Passes add the same interpolated values in another order: float rounding only.
+constexpr double kImageTolerance = 1e-5;
+
+prt::TransferSet bake_small(const meshes::Mesh& mesh, int order, prt::TransferKind kind,
+                            bool coloured = false) {
+  prt::BakeOptions o;
+  o.kind = kind;
+  o.order = order;
+  o.samples = 96;
+  o.bounces = 0;
+  o.material.kind = prt::MaterialKind::kPhong;
+  o.material.exponent = 8.f;
+  if (coloured) o.material.albedo = Eigen::Vector3f(0.5f, 0.3f, 0.1f);
+  return prt::bake(mesh, o);
+}
+
+// Clusters of `group` consecutive vertices, each fitted by exact PCA (Eigen's solver) with
+// `components` PCs: lossless when components >= group - 1, lossy below; coarser groups and
+// fewer PCs lose more. A hand-built stand-in for cpca::compress with a known ordering.
+cpca::CompressedSet compress_by_groups(const prt::TransferSet& t, int group, int components) {
+  cpca::CompressedSet s;
+  s.order = t.order;
+  s.channels = t.channels;
+  s.columns = t.columns();
+  s.vertex_count = t.vertex_count;
+  s.component_count = components;
+  const std::size_t D = t.floats_per_vertex();
+  const int V = int(t.vertex_count);
+  s.cluster_count = (V + group - 1) / group;
+  s.cluster_of.resize(std::size_t(V));
+  s.weights.assign(std::size_t(V) * components, 0.f);
+  s.means.assign(std::size_t(s.cluster_count) * D, 0.f);
+  s.bases.assign(std::size_t(s.cluster_count) * components * D, 0.f);
+  for (int k = 0; k < s.cluster_count; ++k) {
+    const int first = k * group, m = std::min(group, V - first);
+    Eigen::MatrixXd x(m, Eigen::Index(D));
+    for (int i = 0; i < m; ++i) {
+      s.cluster_of[std::size_t(first + i)] = std::uint32_t(k);
+      for (std::size_t d = 0; d < D; ++d) x(i, Eigen::Index(d)) = t.data[(first + i) * D + d];
+    }
+    const Eigen::RowVectorXd mean = x.colwise().mean();
+    const Eigen::MatrixXd centred = x.rowwise() - mean;
+    for (std::size_t d = 0; d < D; ++d) s.means[k * D + d] = float(mean[Eigen::Index(d)]);
+    const int used = std::min(components, m);
+    if (used == 0) continue;
+    // Gram-matrix PCA (m << D): eigenvectors u of C C^T give directions C^T u / sigma.
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(centred * centred.transpose());
+    Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(used, Eigen::Index(D));
+    for (int j = 0; j < used; ++j) {
+      const double lambda = eig.eigenvalues()[m - 1 - j];  // ascending order
+      if (lambda > 1e-20 * std::max(1.0, eig.eigenvalues()[m - 1]))
+        basis.row(j) = (centred.transpose() * eig.eigenvectors().col(m - 1 - j)).transpose() /
+                       std::sqrt(lambda);
+    }
+    const Eigen::MatrixXd w = centred * basis.transpose();
+    for (int j = 0; j < used; ++j)
+      for (std::size_t d = 0; d < D; ++d)
+        s.bases[(std::size_t(k) * components + j) * D + d] = float(basis(j, Eigen::Index(d)));
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < used; ++j)
+        s.weights[std::size_t(first + i) * components + j] = float(w(i, j));
+  }
+  cpca::validate(s);
+  return s;
+}
+
+// A smooth, coloured, clearly directional environment.
+probes::Probe test_probe() {
+  return probes::make_from_function(64, 32, [](const Eigen::Vector3d& d) {
+    const double sun =
+        std::pow(std::max(0.0, d.dot(Eigen::Vector3d(0.3, 0.8, 0.5).normalized())), 8);
+    return probes::Rgb(float(0.2 + 2.0 * sun + 0.3 * std::max(0.0, d.x())), float(0.25 + 1.5 * sun),
+                       float(0.3 + sun + 0.4 * std::max(0.0, -d.z())));
+  });
+}
+
+struct Scene {
+  meshes::Mesh mesh;
+  prt::TransferSet transfer;
+  cpca::CompressedSet set;
+  probes::Probe probe;
+  prt::ShLighting lighting;
+  render::Camera camera;
+};
+
+Scene make_scene(const meshes::Mesh& mesh, int order, int group, int components,
+                 prt::TransferKind kind = prt::TransferKind::kGlossy, bool coloured = false) {
+  Scene s;
+  s.mesh = mesh;
+  s.transfer = bake_small(mesh, order, kind, coloured);
+  s.set = compress_by_groups(s.transfer, group, components);
+  s.probe = test_probe();
+  s.lighting = prt::project(s.probe, order);
+  const meshes::Bounds b = meshes::bounds(mesh);
+  s.camera = render::frame_sphere(b.center().cast<double>(), 0.5 * b.diagonal(), 64, 48);
+  s.camera.eye = s.camera.target + (s.camera.eye - s.camera.target).norm() *
+                                       Eigen::Vector3d(0.3, 0.5, 1.0).normalized();
+  render::fit_clip_planes(s.camera, s.camera.target, 0.5 * b.diagonal());
+  return s;
+}
+
+Eigen::Matrix3d test_rotation() {
+  return prt::axis_angle(Eigen::Vector3d(1, 2, 3).normalized(), 0.7);
+}
+
+render::RendererOptions options(render::Mode mode, int budget = 0) {
+  render::RendererOptions o;
+  o.mode = mode;
+  o.register_budget = budget;
+  return o;
+}
+
+double max_relative_error(const std::vector<render::Rgb>& a, const std::vector<render::Rgb>& ref) {
+  double scale = 0.0, worst = 0.0;
+  for (const auto& r : ref) scale = std::max(scale, double(r.cwiseAbs().maxCoeff()));
+  for (std::size_t i = 0; i < a.size(); ++i)
+    worst = std::max(worst, double((a[i] - ref[i]).cwiseAbs().maxCoeff()));
+  return worst / scale;
+}
+
+double max_abs_difference(const render::Image& a, const render::Image& b) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.rgba.size(); ++i)
+    worst = std::max(worst, double(std::abs(a.rgba[i] - b.rgba[i])));
+  return worst;
+}
+
+render::Image render_once(render::GlContext&, const Scene& s, const render::RendererOptions& o,
+                          const render::Camera& camera, const Eigen::Matrix3d& rotation,
+                          render::RenderStats* stats = nullptr) {
+  render::Renderer r(s.mesh, &s.set, &s.transfer, &s.probe, o);
+  r.render(camera, s.lighting, rotation);
+  if (stats) *stats = r.stats();
+  return r.read_image();
+}
+
+// --- Transform feedback capture against the CPU reference --------------------------------
+
+struct CaptureCase {
+  int order;
+  prt::TransferKind kind;
+  bool coloured;
+};
+
+class CaptureTest : public ::testing::TestWithParam<CaptureCase> {};
+
+TEST_P(CaptureTest, EveryModeMatchesTheCpuReference) {
+  const CaptureCase c = GetParam();
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 6, 0.5f, 1.0f, 12, 6), c.order, 8,
+                             3, c.kind, c.coloured);
+  const Eigen::Matrix3d R = test_rotation();
+  const prt::ShLighting lit = prt::ShRotation(c.order, R).apply(s.lighting);
+  const auto reference = render::reference_vertex_radiance(s.set, s.mesh, lit, s.camera.eye);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  for (render::Mode mode : {render::Mode::kMultipass, render::Mode::kSinglepass,
+                            render::Mode::kDecoupled, render::Mode::kCpu}) {
+    // Three clusters per pass: several passes, so the sum over passes is exercised.
+    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, options(mode, 3 * registers));
+    const auto captured = r.capture_vertex_radiance(s.camera, s.lighting, R);
+    EXPECT_LT(max_relative_error(captured, reference), kVertexTolerance) << render::mode_name(mode);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Orders, CaptureTest,
+                         ::testing::Values(CaptureCase{3, prt::TransferKind::kGlossy, false},
+                                           CaptureCase{6, prt::TransferKind::kGlossy, true},
+                                           CaptureCase{4, prt::TransferKind::kDiffuse, false}));
+
+TEST(Renderer, UncompressedCaptureMatchesLosslessReference) {
+  render::GlContext ctx;
+  // Groups of 4 with 3 PCs reconstruct every vertex exactly (up to float rounding).
+  const Scene s = make_scene(meshes::make_sphere(1.f, 10, 5), 4, 4, 3);
+  const Eigen::Matrix3d R = test_rotation();
+  const prt::ShLighting lit = prt::ShRotation(4, R).apply(s.lighting);
+  const auto reference = render::reference_vertex_radiance(s.set, s.mesh, lit, s.camera.eye);
+  render::Renderer r(s.mesh, nullptr, &s.transfer, &s.probe, options(render::Mode::kUncompressed));
+  EXPECT_LT(max_relative_error(r.capture_vertex_radiance(s.camera, s.lighting, R), reference),
+            kVertexTolerance);
+}
+
+// --- Multipass equals single pass --------------------------------------------------------
+
+TEST(Renderer, MultipassEqualsSinglepassForOneTwoAndManyPasses) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 4, 12, 4);
+  const int K = s.set.cluster_count;
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  const Eigen::Matrix3d R = test_rotation();
+  const render::Image single = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
+  const double scale = single.max_rgb();
+  ASSERT_GT(scale, 0.0);
+  for (int per_pass : {K, (K + 1) / 2, 1}) {
+    render::RenderStats stats;
+    const render::Image multi = render_once(
+        ctx, s, options(render::Mode::kMultipass, per_pass * registers), s.camera, R, &stats);
+    EXPECT_EQ(stats.passes, (K + per_pass - 1) / per_pass);
+    EXPECT_LT(max_abs_difference(multi, single), kImageTolerance * scale)
+        << per_pass << " clusters per pass";
+  }
+  // Alpha is coverage: both 0 and 1 occur, nothing else.
+  int covered = 0;
+  for (int i = 0; i < single.width * single.height; ++i) {
+    const float a = single.rgba[std::size_t(i) * 4 + 3];
+    EXPECT_TRUE(a == 0.f || a == 1.f);
+    covered += a == 1.f;
+  }
+  EXPECT_GT(covered, 100);
+  EXPECT_LT(covered, single.width * single.height);
+}
+
+TEST(Renderer, DecoupledCpuAndSinglepassImagesAgree) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_torus(1.f, 0.4f, 24, 12), 5, 10, 4);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  const Eigen::Matrix3d R = test_rotation();
+  const render::Image single = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
+  const double scale = single.max_rgb();
+  for (render::Mode mode : {render::Mode::kDecoupled, render::Mode::kCpu}) {
+    render::RenderStats stats;
+    const render::Image other =
+        render_once(ctx, s, options(mode, 2 * registers), s.camera, R, &stats);
+    EXPECT_LT(max_abs_difference(other, single), kImageTolerance * scale)
+        << render::mode_name(mode);
+    EXPECT_DOUBLE_EQ(stats.average_overdraw, 1.0);
+  }
+}
+
+// --- Triangles drawn ---------------------------------------------------------------------
+
+TEST(Renderer, TrianglesDrawnMatchTheClusterPrediction) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 3, 10, 2);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  std::vector<cpca::TriangleIndices> tris(s.mesh.triangles.begin(), s.mesh.triangles.end());
+  for (int per_pass : {1, 3}) {
+    render::RendererOptions o = options(render::Mode::kMultipass, per_pass * registers);
+    o.count_primitives = true;
+    // A grouping other than cluster order: odd clusters first, to show the strategy is used.
+    cpca::SuperClusters groups;
+    std::vector<std::uint32_t> order;
+    for (int k = 1; k < s.set.cluster_count; k += 2) order.push_back(std::uint32_t(k));
+    for (int k = 0; k < s.set.cluster_count; k += 2) order.push_back(std::uint32_t(k));
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      if (i % std::size_t(per_pass) == 0) groups.passes.emplace_back();
+      groups.passes.back().push_back(order[i]);
+    }
+    o.groups = groups;
+    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
+    r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
+    const cpca::OverdrawStats predicted = cpca::overdraw(s.set.cluster_of, tris, groups);
+    EXPECT_EQ(r.stats().triangles_per_pass, predicted.triangles_per_pass);
+    EXPECT_EQ(r.stats().measured_triangles, predicted.triangles_per_pass);
+    EXPECT_DOUBLE_EQ(r.stats().average_overdraw, predicted.average_overdraw);
+    EXPECT_GT(predicted.average_overdraw, 1.0);
+  }
+}
+
+// --- Rotation symmetry ---------------------------------------------------------------------
+
+TEST(Renderer, RotatingProbeAndCameraTogetherLeavesTheSphereUnchanged) {
+  render::GlContext ctx;
+  // Lossless compression (groups of 6, 5 PCs), so only the renderer is under test.
+  Scene s = make_scene(meshes::make_sphere(1.f, 48, 24), 4, 6, 5);
+  s.camera = render::frame_sphere(Eigen::Vector3d::Zero(), 1.0, 96, 72);
+  const Eigen::Matrix3d R = prt::axis_angle(Eigen::Vector3d(1, -2, 0.5).normalized(), 0.9);
+  const render::RendererOptions o = options(render::Mode::kSinglepass);
+  const render::Image base = render_once(ctx, s, o, s.camera, Eigen::Matrix3d::Identity());
+  const render::Image both = render_once(ctx, s, o, render::rotated(s.camera, R), R);
+  const render::Image camera_only =
+      render_once(ctx, s, o, render::rotated(s.camera, R), Eigen::Matrix3d::Identity());
+  auto mean_difference = [&](const render::Image& a) {
+    double diff = 0.0, sum = 0.0;
+    for (std::size_t i = 0; i < a.rgba.size(); ++i) {
+      if (i % 4 == 3) continue;
+      diff += std::abs(a.rgba[i] - base.rgba[i]);
+      sum += std::abs(base.rgba[i]);
+    }
+    return diff / sum;
+  };
+  // Tessellation and per-vertex interpolation are not rotation invariant: silhouettes and
+  // shading move by a fraction of a triangle. 1% of the mean radiance allows that; a wrong
+  // rotation convention changes the image by far more (checked just below).
+  const double together = mean_difference(both);
+  EXPECT_LT(together, 0.01);
+  EXPECT_GT(mean_difference(camera_only), 10 * together);
+}
+
+// --- Background ------------------------------------------------------------------------------
+
+TEST(Renderer, BackgroundIsTheRotatedProbe) {
+  render::GlContext ctx;
+  Scene s = make_scene(meshes::make_sphere(0.2f, 8, 4), 2, 8, 1);
+  s.camera = render::frame_sphere(Eigen::Vector3d::Zero(), 3.0, 40, 30, 60.0);
+  const Eigen::Matrix3d R = test_rotation();
+  const render::Image image = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
+  for (auto [x, y] : {std::pair{0, 0}, {39, 0}, {0, 29}, {39, 29}, {5, 20}}) {
+    const Eigen::Vector3d w = s.camera.pixel_direction(x, y);
+    const probes::Rgb expected = s.probe.lookup(R.transpose() * w);
+    const float* px = image.pixel(x, y);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(px[c], expected[c], 2e-3 * expected.maxCoeff()) << x << "," << y;
+    EXPECT_EQ(px[3], 0.f);
+  }
+  // Solid colour replaces it.
+  render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, options(render::Mode::kSinglepass));
+  r.set_background({false, render::Rgb(0.25f, 0.5f, 0.75f)});
+  r.render(s.camera, s.lighting, R);
+  const render::Image solid = r.read_image();
+  EXPECT_EQ(solid.pixel(0, 0)[0], 0.25f);
+  EXPECT_EQ(solid.pixel(0, 0)[2], 0.75f);
+}
+
+// --- Compression error ---------------------------------------------------------------------
+
+TEST(Renderer, CompressedErrorFallsAsComponentsAndClustersGrow) {
+  render::GlContext ctx;
+  Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 4, 8, 1);
+  const Eigen::Matrix3d R = test_rotation();
+  const render::Image truth =
+      render_once(ctx, s, options(render::Mode::kUncompressed), s.camera, R);
+  auto error_of = [&](int group, int components) {
+    s.set = compress_by_groups(s.transfer, group, components);
+    const render::Image img = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
+    double e = 0.0;
+    for (std::size_t i = 0; i < img.rgba.size(); ++i) {
+      const double d = img.rgba[i] - truth.rgba[i];
+      e += d * d;
+    }
+    return std::sqrt(e / double(img.rgba.size()));
+  };
+  // More PCs at a fixed clustering (nested subspaces).
+  const double pcs1 = error_of(32, 1), pcs3 = error_of(32, 3), pcs8 = error_of(32, 8);
+  EXPECT_LT(pcs3, pcs1);
+  EXPECT_LT(pcs8, pcs3);
+  // More clusters at a fixed PC count (nested partitions: 64 -> 16 -> 4 vertices each).
+  const double k64 = error_of(64, 2), k16 = error_of(16, 2), k4 = error_of(4, 2);
+  EXPECT_LT(k16, k64);
+  EXPECT_LT(k4, k16);
+  // Groups of 4 with 3 PCs are lossless: what is left is the two paths' float rounding.
+  EXPECT_LT(error_of(4, 3), 1e-4 * truth.max_rgb());
+  EXPECT_LT(error_of(4, 3), 0.01 * k4);
+}
+
+// --- Errors --------------------------------------------------------------------------------
+
+TEST(Renderer, RejectsBudgetsBelowOneCluster) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_sphere(1.f, 8, 4), 3, 8, 2);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  EXPECT_THROW(render::Renderer(s.mesh, &s.set, nullptr, nullptr,
+                                options(render::Mode::kMultipass, registers - 1)),
+               std::invalid_argument);
+  EXPECT_THROW(
+      render::Renderer(s.mesh, nullptr, nullptr, nullptr, options(render::Mode::kUncompressed)),
+      std::invalid_argument);
+  EXPECT_THROW(render::parse_mode("fast"), std::invalid_argument);
+}
+
+}  // namespace
