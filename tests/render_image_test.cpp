@@ -1,0 +1,180 @@
+// Image output and the camera: the EXR holds exactly the framebuffer (read back through
+// OpenImageIO itself, not our reader), the PNG holds the documented tone map, writes are
+// atomic, and the default camera frames the bounding sphere.
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+
+#include "meshes/procedural.h"
+#include "probes/procedural.h"
+#include "render/gl_context.h"
+#include "test_support.h"
+
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// A diffuse, one-cluster set with no PCs: radiance = mean . l for every vertex, enough to
+// fill a framebuffer with a real render.
+cpca::CompressedSet constant_set(std::size_t vertices, int order) {
+  cpca::CompressedSet s;
+  s.order = order;
+  s.channels = 1;
+  s.columns = 1;
+  s.vertex_count = vertices;
+  s.cluster_count = 1;
+  s.component_count = 0;
+  s.cluster_of.assign(vertices, 0);
+  s.means.assign(std::size_t(order * order), 0.f);
+  s.means[0] = 1.f;
+  return s;
+}
+
+render::Image rendered_image(render::GlContext&) {
+  const meshes::Mesh mesh = meshes::make_sphere(1.f, 16, 8);
+  const cpca::CompressedSet set = constant_set(mesh.vertex_count(), 2);
+  const probes::Probe probe = probes::make_from_function(32, 16, [](const Eigen::Vector3d& d) {
+    return probes::Rgb(float(1.0 + d.x()), float(1.0 + d.y()), float(2.0 + d.z()));
+  });
+  prt::ShLighting l = prt::ShLighting::Zero(4, 3);
+  l.row(0) << 0.5, 1.5, 3.0;
+  render::RendererOptions o;
+  o.mode = render::Mode::kSinglepass;
+  render::Renderer r(mesh, &set, nullptr, &probe, o);
+  r.render(render::frame_sphere(Eigen::Vector3d::Zero(), 1.0, 40, 30), l,
+           Eigen::Matrix3d::Identity());
+  return r.read_image();
+}
+
+TEST(Image, ExrRoundTripThroughOpenImageIo) {
+  render::GlContext ctx;
+  const render::Image image = rendered_image(ctx);
+  ASSERT_EQ(image.width, 40);
+  ASSERT_EQ(image.height, 30);
+  const fs::path path = test_support::scratch("render_image", "round_trip.exr");
+  render::write_exr(path, image);
+
+  auto in = OIIO::ImageInput::open(path.string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const OIIO::ImageSpec& spec = in->spec();
+  EXPECT_EQ(spec.width, 40);
+  EXPECT_EQ(spec.height, 30);
+  ASSERT_EQ(spec.nchannels, 4);
+  EXPECT_EQ(spec.channelnames, (std::vector<std::string>{"R", "G", "B", "A"}));
+  EXPECT_EQ(spec.alpha_channel, 3);
+  std::vector<float> pixels(std::size_t(40) * 30 * 4);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, pixels.data()));
+  EXPECT_EQ(pixels, image.rgba);  // float EXR: bit exact
+  // The render has both coverage values and radiance (mesh: 1, 1.5 .. on the background).
+  int covered = 0;
+  for (std::size_t i = 3; i < pixels.size(); i += 4) covered += pixels[i] == 1.f;
+  EXPECT_GT(covered, 50);
+  EXPECT_LT(covered, 40 * 30);
+  // The centre pixel is the sphere: radiance (0.5, 1.5, 3) times the constant y_0 = 1
+  // (diffuse: the mean . l with mean = e_0).
+  const float* centre = image.pixel(20, 15);
+  EXPECT_FLOAT_EQ(centre[0], 0.5f);
+  EXPECT_FLOAT_EQ(centre[2], 3.0f);
+  EXPECT_EQ(centre[3], 1.f);
+}
+
+TEST(Image, PngHoldsTheToneMappedValues) {
+  render::GlContext ctx;
+  const render::Image image = rendered_image(ctx);
+  const fs::path path = test_support::scratch("render_image", "tone.png");
+  render::write_png(path, image, 1.0);
+  const render::Image png = render::read_image(path);
+  ASSERT_EQ(png.width, image.width);
+  ASSERT_EQ(png.height, image.height);
+  for (int y = 0; y < image.height; y += 7)
+    for (int x = 0; x < image.width; x += 5)
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(png.pixel(x, y)[c], render::tone_map(image.pixel(x, y)[c], 1.0),
+                    0.5 / 255.0 + 1e-6);
+}
+
+TEST(Image, ToneMapIsMonotoneAndBounded) {
+  EXPECT_EQ(render::tone_map(0.f, 0.0), 0.f);
+  EXPECT_EQ(render::tone_map(-1.f, 0.0), 0.f);
+  float previous = 0.f;
+  for (float v = 0.01f; v < 100.f; v *= 1.5f) {
+    const float t = render::tone_map(v, 0.0);
+    // The ACES fit reaches 1 (then clamps) a little above 10.
+    if (v < 8.f) {
+      EXPECT_GT(t, previous) << v;
+    }
+    EXPECT_GE(t, previous);
+    EXPECT_LE(t, 1.f);
+    previous = t;
+  }
+  // One stop of exposure doubles the input.
+  EXPECT_FLOAT_EQ(render::tone_map(0.25f, 1.0), render::tone_map(0.5f, 0.0));
+}
+
+TEST(Image, WritesAreAtomic) {
+  render::Image image;
+  image.width = 4;
+  image.height = 2;
+  image.rgba.assign(32, 0.5f);
+  const fs::path dir = test_support::scratch("render_image", "atomic");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  render::write_exr(dir / "a.exr", image);
+  render::write_png(dir / "a.png", image);
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"a.exr", "a.png"}));  // no temporaries left
+  EXPECT_THROW(render::write_exr(dir / "missing" / "b.exr", image), render::ImageError);
+  EXPECT_THROW(render::write_exr(dir / "c.unknownext", image), render::ImageError);
+  names.clear();
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  EXPECT_EQ(names.size(), 2u);
+}
+
+TEST(Camera, FramesTheBoundingSphere) {
+  const Eigen::Vector3d centre(1, 2, 3);
+  for (auto [w, h] : {std::pair{64, 48}, {48, 64}}) {
+    const render::Camera c = render::frame_sphere(centre, 2.0, w, h, 40.0);
+    EXPECT_NO_THROW(c.validate());
+    const Eigen::Matrix4d clip = c.clip_from_world();
+    // Every point of the sphere projects inside the image and between the clip planes.
+    double extent = 0.0;
+    for (int i = 0; i < 500; ++i) {
+      const double z = -1.0 + 2.0 * (i + 0.5) / 500, phi = 2.399963 * i;
+      const Eigen::Vector3d p =
+          centre + 2.0 * Eigen::Vector3d(std::sqrt(1 - z * z) * std::cos(phi),
+                                         std::sqrt(1 - z * z) * std::sin(phi), z);
+      const Eigen::Vector4d q = clip * p.homogeneous();
+      const Eigen::Vector3d ndc = q.head<3>() / q.w();
+      EXPECT_LT(ndc.head<2>().cwiseAbs().maxCoeff(), 1.0);
+      EXPECT_LT(std::abs(ndc.z()), 1.0);
+      extent = std::max(extent, ndc.head<2>().cwiseAbs().maxCoeff());
+    }
+    EXPECT_GT(extent, 0.8);  // framed, not lost in the middle
+  }
+}
+
+TEST(Camera, PixelDirectionsMatchTheProjection) {
+  render::Camera c = render::frame_sphere(Eigen::Vector3d::Zero(), 1.0, 32, 24, 50.0);
+  c.eye = Eigen::Vector3d(2, 1, 3);
+  const Eigen::Matrix4d clip = c.clip_from_world();
+  for (auto [x, y] : {std::pair{0, 0}, {31, 0}, {10, 20}}) {
+    const Eigen::Vector3d p = c.eye + 2.0 * c.pixel_direction(x, y);
+    const Eigen::Vector4d q = clip * p.homogeneous();
+    EXPECT_NEAR((q.x() / q.w() + 1) * 0.5 * 32, x + 0.5, 1e-9);
+    EXPECT_NEAR((1 - q.y() / q.w()) * 0.5 * 24, y + 0.5, 1e-9);  // row 0 at the top
+  }
+  c.up = c.target - c.eye;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
+}  // namespace
