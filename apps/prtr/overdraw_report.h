@@ -1,0 +1,71 @@
+// apps/prtr/overdraw_report.h: the results of `prtr overdraw` (issue 6) and their four
+// renderings: Markdown tables in the thesis's column order (tables 5.2-5.17: method,
+// clustering time, average triangle overdraw, FPS, Average SE, then our image RMSE), CSV,
+// JSON, and the plot of overdraw against cluster count.
+#pragma once
+
+#include "render/false_colour.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace prtr_app {
+
+// One measured configuration: a compression (K x method) grouped by one strategy under one
+// register budget, rendered multipass.
+struct OverdrawRow {
+  int clusters = 0;
+  std::string method;  // "original", "overdraw-reduction", "coherence", "both", ...
+  std::string budget;  // "default" or "thesis"
+  int register_budget = 0;
+  int clusters_per_pass = 0;
+  int passes = 0;
+  std::string strategy;
+  double clustering_seconds = 0;
+  double grouping_seconds = 0;
+  double average_overdraw = 0;        // exact, cpca::overdraw
+  std::uint64_t triangles_drawn = 0;  // = the renderer's GL count (checked)
+  double fps = 0, frame_ms = 0, cpu_ms = 0, gl_ms = 0;
+  double average_se = 0, relative_error = 0;
+  double image_rmse = 0, image_rmse_relative = 0;  // against the uncompressed render
+  double multi_cluster_triangles = 0;              // share of triangles spanning clusters
+};
+
+// FPS of the other render modes per K (the original CPCA set), for "what the overdraw costs".
+struct ModeTiming {
+  int clusters = 0;  // 0 for the uncompressed render
+  std::string mode;
+  double fps = 0, frame_ms = 0;
+  double image_rmse = 0, image_rmse_relative = 0;
+};
+
+struct OverdrawReport {
+  std::string mesh, probe, transfer, bake;  // bake: one-line description of its parameters
+  bool bake_cached = false;                 // the transfer came from the cache
+  bool compressions_cached = false;         // some compressed sets came from the cache
+  std::uint64_t vertices = 0, triangles = 0;
+  int order = 0, pcs = 0, width = 0, height = 0, frames = 0, warmup = 0;
+  int registers_per_cluster = 0;
+  double degrees_per_frame = 0, image_rotation_degrees = 0;
+  std::string gl_renderer;
+  std::vector<OverdrawRow> rows;
+  std::vector<ModeTiming> modes;
+};
+
+// Per budget and K, one table in the thesis's column order; then per K the FPS of multipass
+// (best strategy of the original method) against single-pass and decoupled.
+std::string markdown(const OverdrawReport& report);
+std::string csv(const OverdrawReport& report);
+std::string json(const OverdrawReport& report);
+
+// Average overdraw against K, one line per method with its lowest-overdraw strategy at each
+// K, for the rows of `budget`; axes, ticks and a legend. Throws std::invalid_argument when
+// there is no row for `budget`.
+render::Picture overdraw_plot(const OverdrawReport& report, const std::string& budget,
+                              int width = 900, int height = 600);
+
+// "3 m 53 s" / "12.4 s", the thesis's style for clustering times.
+std::string format_duration(double seconds);
+
+}  // namespace prtr_app
