@@ -128,5 +128,29 @@ fi
 
 run gl-info; expect_code 0 && [[ $out == *"Core"* || $out == *"core profile"* ]]; check "gl-info: core context" $?
 
+# prtr overdraw on the 8-vertex cube with tiny settings: tables, CSV, JSON, plot, pictures,
+# the bake cache, and usage errors.
+if [[ -f $forest ]]; then
+  od=(overdraw "$tmp/cube.obj" --probe "$forest" --order 2 --samples 32 --bounces 0
+      --clusters 2,4 --pcs 2 --rows original,both --strategies order,ils --frames 1 --warmup 0
+      --width 64 --height 48 --cache "$tmp/od_cache" --out "$tmp/od" -q)
+  run "${od[@]}"; expect_code 0; check "overdraw: tiny run exits 0 ($err)" $?
+  [[ $out == *"baked now, cached as"* ]]; check "overdraw: first run bakes and says it caches" $?
+  [[ $out =~ \|\ both\ \|\ ils\ \|\ [0-9.]+\ s\ \|\ 1\.[0-9]{6}\ \| ]]; check "overdraw: a table row for both/ils" $?
+  [[ $out == *"4 clusters, thesis budget"* && $out == *"4 clusters, default budget"* ]]; check "overdraw: both budgets tabled" $?
+  rows=$(($(wc -l <"$tmp/od/overdraw.csv") - 1))
+  [[ $rows == 16 ]]; check "overdraw: 2 K x 2 methods x 2 budgets x 2 strategies CSV rows (got $rows)" $?
+  [[ $(head -c 1 "$tmp/od/overdraw.json") == "{" ]] && grep -q '"rows":\[{' "$tmp/od/overdraw.json"; check "overdraw: JSON with rows" $?
+  for f in overdraw-plot.png clusters-K4-original.png clusters-K4-both.png; do
+    [[ -s $tmp/od/$f ]]; check "overdraw: wrote $f" $?
+  done
+  ls "$tmp"/od/overdraw-K4-original-*-thesis.png >/dev/null 2>&1; check "overdraw: wrote the K=4 overdraw picture" $?
+  run "${od[@]}"; expect_code 0 && [[ $out == *"(cached: "* && $out == *"came from the cache"* ]]; check "overdraw: second run uses the cached bake and compressions" $?
+  run overdraw "$tmp/cube.obj" --probe "$forest" --rows bogus; expect_code 2 && [[ $err == *--rows* ]]; check "overdraw: unknown row is a usage error" $?
+  run overdraw "$tmp/cube.obj" --probe "$forest" --strategies best; expect_code 2 && [[ $err == *--strategies* ]]; check "overdraw: unknown strategy is a usage error" $?
+  run overdraw "$tmp/cube.obj" --probe "$forest" --clusters 0; expect_code 2; check "overdraw: --clusters 0 is a usage error" $?
+  run overdraw "$tmp/cube.obj" --probe "$forest" --transfer "$tmp/cube.prtx" --order 3; expect_code 2 && [[ $err == *--order* ]]; check "overdraw: bake flag with --transfer is a usage error" $?
+fi
+
 echo "cli: $passed passed, $failed failed"
 ((failed == 0))
