@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   add(prtr_app::add_bake_command);
   add(prtr_app::add_compress_command);
   add(prtr_app::add_overdraw_command);
+  add(prtr_app::add_render_command);
   add(prtr_app::add_info_command);
   add(prtr_app::add_gl_info_command);
 
