@@ -5,6 +5,7 @@
 #include "cpca/compress.h"
 #include "cpca/compressed_file.h"
 #include "meshes/load.h"
+#include "pipeline.h"
 #include "progress_bar.h"
 #include "prt/transfer_file.h"
 
@@ -13,17 +14,6 @@
 #include <string>
 
 namespace prtr_app {
-namespace {
-
-cpca::Geometry geometry_of(const meshes::Mesh& mesh) {
-  cpca::Geometry g;
-  g.positions = mesh.positions;
-  g.triangles.reserve(mesh.triangles.size());
-  for (const meshes::Triangle& t : mesh.triangles) g.triangles.push_back({t[0], t[1], t[2]});
-  return g;
-}
-
-}  // namespace
 
 Runner add_compress_command(CLI::App& app) {
   struct Options {
@@ -91,37 +81,11 @@ Runner add_compress_command(CLI::App& app) {
                        " must be below the data dimension " + std::to_string(dimension) + " of " +
                        o.transfer);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
-    if (meshes::content_hash(mesh) != header.mesh_hash ||
-        mesh.vertex_count() != header.vertex_count)
-      throw std::runtime_error(o.transfer + " was not baked from " + o.mesh +
-                               " (mesh hash or vertex count differ); bake it again with prtr bake");
-    const std::string absolute = std::filesystem::absolute(o.mesh).lexically_normal().string();
-    if (absolute.size() > cpca::kMaxMeshPathBytes)
-      throw UsageError("--mesh path is longer than " + std::to_string(cpca::kMaxMeshPathBytes) +
-                       " bytes; move the mesh to a shorter path");
-
-    ProgressBar bar(o.quiet || o.json);
-    bar.update("reading transfer", 0, 1);
     const prt::TransferSet transfer = prt::read_transfer(o.transfer);
-    const Eigen::Map<const cpca::DataMatrix> data(
-        transfer.data.data(), Eigen::Index(transfer.vertex_count), Eigen::Index(dimension));
-    o.compress.layout = {transfer.order, transfer.channels, transfer.columns()};
-    const cpca::Geometry geometry = geometry_of(mesh);
     cpca::CompressReport report;
-    cpca::CompressedSet set = cpca::compress(data, o.compress, &geometry, &report,
-                                             [&](const std::string& stage, double f) {
-                                               bar.update(stage == "lbg"    ? "LBG clustering"
-                                                          : stage == "pca"  ? "PCA per cluster"
-                                                          : stage == "cpca" ? "iterative CPCA"
-                                                                            : "overdraw reduction",
-                                                          std::uint64_t(f * 1000), 1000);
-                                             });
-    set.mesh_hash = transfer.mesh_hash;
-    set.transfer_hash = transfer.payload_checksum;
-    set.mesh_path = absolute;
-    bar.update("writing", 0, 1);
+    const cpca::CompressedSet set =
+        run_compress(transfer, mesh, o.mesh, o.compress, o.quiet || o.json, &report);
     cpca::write_compressed(o.output, set);
-    bar.finish();
 
     const double raw_bytes = double(transfer.data.size()) * 4.0;
     const double file_bytes = double(std::filesystem::file_size(o.output));

@@ -1,0 +1,91 @@
+#include "bake_flags.h"
+
+#include "commands.h"
+
+#include <sstream>
+#include <vector>
+
+namespace prtr_app {
+namespace {
+
+// "0.5" (grey) or "0.5,0.4,0.3".
+Eigen::Vector3f parse_albedo(const std::string& text) {
+  std::vector<float> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stof(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--albedo: '" + text + "' is not a number or R,G,B triple");
+    }
+  }
+  if (values.size() == 1) return Eigen::Vector3f::Constant(values[0]);
+  if (values.size() == 3) return {values[0], values[1], values[2]};
+  throw UsageError("--albedo takes one value (grey) or three (R,G,B), got '" + text + "'");
+}
+
+}  // namespace
+
+void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
+  f.command = cmd;
+  cmd->add_option("--kind", f.kind, "diffuse: transfer vectors; glossy: transfer matrices")
+      ->check(CLI::IsMember({"diffuse", "glossy"}))
+      ->capture_default_str();
+  cmd->add_option("--order", f.bake.order, "SH order N (N^2 coefficients)")
+      ->check(CLI::Range(1, 10))
+      ->capture_default_str();
+  cmd->add_option("--samples", f.bake.samples, "Hemisphere directions per vertex")
+      ->check(CLI::Range(1, 65536))
+      ->capture_default_str();
+  cmd->add_option("--bounces", f.bake.bounces, "Interreflection passes (0: shadows only)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  cmd->add_option("--seed", f.bake.seed, "Seed of the direction set")->capture_default_str();
+  cmd->add_option("--material", f.material, "Reflectance model")
+      ->check(CLI::IsMember({"lambert", "phong", "cook-torrance"}))
+      ->capture_default_str();
+  cmd->add_option("--albedo", f.albedo, "Diffuse albedo: one value (grey) or R,G,B")
+      ->capture_default_str();
+  cmd->add_option("--specular", f.bake.material.specular,
+                  "Specular reflectance (phong, cook-torrance)")
+      ->capture_default_str();
+  cmd->add_option("--exponent", f.bake.material.exponent, "Phong exponent")->capture_default_str();
+  cmd->add_option("--roughness", f.bake.material.roughness, "Cook-Torrance Beckmann roughness")
+      ->capture_default_str();
+  cmd->add_option("--f0", f.bake.material.f0,
+                  "Cook-Torrance Fresnel reflectance at normal incidence")
+      ->capture_default_str();
+  cmd->add_option("--ray-offset", f.bake.ray_offset,
+                  "Ray start offset along the normal, times the bounding-box diagonal")
+      ->capture_default_str();
+}
+
+prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
+  prt::BakeOptions bake = f.bake;
+  bake.kind = f.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;
+  bake.material.kind = prt::parse_material(f.material);
+  bake.material.albedo = parse_albedo(f.albedo);
+  // A flag the chosen material never reads is a mistake worth reporting.
+  const auto kind = bake.material.kind;
+  auto unused = [&](const char* flag, bool used) {
+    if (f.command && f.command->count(flag) && !used) {
+      throw UsageError(std::string(flag) + " does not apply to --material " + f.material);
+    }
+  };
+  unused("--exponent", kind == prt::MaterialKind::kPhong);
+  unused("--roughness", kind == prt::MaterialKind::kCookTorrance);
+  unused("--f0", kind == prt::MaterialKind::kCookTorrance);
+  unused("--specular", kind != prt::MaterialKind::kLambert);
+  if (kind == prt::MaterialKind::kLambert) bake.material.specular = 0.f;
+  try {
+    prt::validate(bake);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return bake;
+}
+
+}  // namespace prtr_app

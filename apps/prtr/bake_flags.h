@@ -1,0 +1,26 @@
+// apps/prtr/bake_flags.h: the bake flags (--kind, --order, --samples, --bounces, --seed,
+// --material and its parameters, --ray-offset), shared by every command that bakes: prtr bake,
+// and prtr relight / overdraw through the cache.
+#pragma once
+
+#include "prt/bake.h"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace prtr_app {
+
+struct BakeFlags {
+  std::string kind = "glossy", material = "phong", albedo = "0.5";
+  prt::BakeOptions bake;
+  CLI::App* command = nullptr;  // to tell which flags were given
+};
+
+void add_bake_flags(CLI::App* command, BakeFlags& flags);
+
+// The options the flags describe, validated; UsageError naming the flag otherwise (also for
+// a material parameter the chosen material never reads).
+prt::BakeOptions resolve_bake_flags(const BakeFlags& flags);
+
+}  // namespace prtr_app

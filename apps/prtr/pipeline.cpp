@@ -1,0 +1,179 @@
+#include "pipeline.h"
+
+#include "common/hash.h"
+#include "cpca/compressed_file.h"
+#include "progress_bar.h"
+#include "prt/transfer_file.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <stdexcept>
+
+namespace prtr_app {
+namespace fs = std::filesystem;
+
+cpca::Geometry geometry_of(const meshes::Mesh& mesh) {
+  cpca::Geometry g;
+  g.positions = mesh.positions;
+  g.triangles.reserve(mesh.triangles.size());
+  for (const meshes::Triangle& t : mesh.triangles) g.triangles.push_back({t[0], t[1], t[2]});
+  return g;
+}
+
+prt::TransferSet run_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
+                          prt::BakeOptions options, bool quiet, prt::BakeStats* stats) {
+  const prt::BakeEstimate estimate = prt::estimate_bake(mesh, options);
+  const std::uint64_t available = prt::available_memory();
+  if (available > 0 && estimate.bytes > available) {
+    throw std::runtime_error("baking " + mesh_name + " needs about " +
+                             format_bytes(estimate.bytes) + " but only " + format_bytes(available) +
+                             " is available; lower --order or --samples, use --bounces 0, "
+                             "or --kind diffuse");
+  }
+  if (!quiet) {
+    std::fprintf(stderr,
+                 "bake: %zu vertices, %s order %d, %d samples, %d bounce(s); about %s of "
+                 "memory, %.1f M shadow rays, roughly %.0f s\n",
+                 mesh.vertex_count(), prt::transfer_kind_name(options.kind), options.order,
+                 options.samples, options.bounces, format_bytes(estimate.bytes).c_str(),
+                 double(estimate.rays) / 1e6, estimate.seconds);
+  }
+  ProgressBar bar(quiet);
+  options.progress = [&bar](const prt::BakeProgress& p) {
+    bar.update(p.pass == 0 ? "shadow pass" : "bounce " + std::to_string(p.pass), p.done, p.total);
+  };
+  prt::TransferSet set = prt::bake(mesh, options, stats);
+  bar.finish();
+  return set;
+}
+
+cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes::Mesh& mesh,
+                                 const std::string& mesh_path, cpca::CompressOptions options,
+                                 bool quiet, cpca::CompressReport* report) {
+  if (meshes::content_hash(mesh) != transfer.mesh_hash ||
+      mesh.vertex_count() != transfer.vertex_count)
+    throw std::runtime_error("the transfer was not baked from " + mesh_path +
+                             " (mesh hash or vertex count differ); bake it again with prtr bake");
+  const std::string absolute = fs::absolute(mesh_path).lexically_normal().string();
+  if (absolute.size() > cpca::kMaxMeshPathBytes)
+    throw std::runtime_error(mesh_path + ": path longer than " +
+                             std::to_string(cpca::kMaxMeshPathBytes) +
+                             " bytes; move the mesh to a shorter path");
+  const Eigen::Map<const cpca::DataMatrix> data(transfer.data.data(),
+                                                Eigen::Index(transfer.vertex_count),
+                                                Eigen::Index(transfer.floats_per_vertex()));
+  options.layout = {transfer.order, transfer.channels, transfer.columns()};
+  const cpca::Geometry geometry = geometry_of(mesh);
+  ProgressBar bar(quiet);
+  cpca::CompressedSet set =
+      cpca::compress(data, options, &geometry, report, [&](const std::string& stage, double f) {
+        bar.update(stage == "lbg"    ? "LBG clustering"
+                   : stage == "pca"  ? "PCA per cluster"
+                   : stage == "cpca" ? "iterative CPCA"
+                                     : "overdraw reduction",
+                   std::uint64_t(f * 1000), 1000);
+      });
+  bar.finish();
+  set.mesh_hash = transfer.mesh_hash;
+  set.transfer_hash = transfer.payload_checksum;
+  set.mesh_path = absolute;
+  return set;
+}
+
+fs::path default_cache_dir() {
+  if (const char* dir = std::getenv("PRTR_CACHE"); dir && *dir) return dir;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return fs::path(xdg) / "prtr";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return fs::path(home) / ".cache" / "prtr";
+  return fs::path("prtr-cache");
+}
+
+namespace {
+
+std::string hex(std::uint64_t h) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+std::uint64_t hash_text(const std::string& text) {
+  return common::fnv1a(text.data(), text.size());
+}
+
+void prepare(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec)
+    throw std::runtime_error("cache directory " + dir.string() + " cannot be created (" +
+                             ec.message() + "); pass --cache DIR or set PRTR_CACHE");
+}
+
+void discard(const fs::path& entry, const std::exception& why) {
+  std::fprintf(stderr, "prtr: cache entry %s is unusable (%s); rebuilding it\n",
+               entry.string().c_str(), why.what());
+  std::error_code ec;
+  fs::remove(entry, ec);
+}
+
+}  // namespace
+
+CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
+                        const prt::BakeOptions& o, const fs::path& cache_dir, bool quiet) {
+  std::ostringstream key;
+  key.precision(9);
+  const prt::Material& m = o.material;
+  key << "bake v1 mesh " << hex(meshes::content_hash(mesh)) << " kind " << int(o.kind) << " order "
+      << o.order << " samples " << o.samples << " bounces " << o.bounces << " seed " << o.seed
+      << " ray_offset " << o.ray_offset << " material " << int(m.kind) << ' ' << m.albedo.x() << ' '
+      << m.albedo.y() << ' ' << m.albedo.z() << ' ' << m.specular << ' ' << m.exponent << ' '
+      << m.roughness << ' ' << m.f0;
+  CacheResult r{cache_dir / ("bake-" + hex(hash_text(key.str())) + ".prtx"), false};
+  if (fs::exists(r.path)) {
+    try {
+      const prt::TransferSet header = prt::read_transfer_header(r.path);
+      if (header.mesh_hash != meshes::content_hash(mesh))
+        throw std::runtime_error("baked from another mesh");
+      r.hit = true;
+      return r;
+    } catch (const std::exception& e) {
+      discard(r.path, e);
+    }
+  }
+  prepare(cache_dir);
+  prt::write_transfer(r.path, run_bake(mesh, mesh_name, o, quiet));
+  return r;
+}
+
+CacheResult cached_compress(const fs::path& transfer_path, const meshes::Mesh& mesh,
+                            const std::string& mesh_path, const cpca::CompressOptions& o,
+                            const fs::path& cache_dir, bool quiet) {
+  const prt::TransferSet header = prt::read_transfer_header(transfer_path);
+  std::ostringstream key;
+  key.precision(9);
+  key << "cpca v1 transfer " << hex(header.payload_checksum) << " mesh "
+      << fs::absolute(mesh_path).lexically_normal().string() << " clusters " << o.clusters
+      << " pcs " << o.components << " method " << int(o.method) << " solver " << int(o.solver)
+      << " alpha " << o.alpha << " overdraw " << o.overdraw_reduction << ' ' << o.overdraw.tolerance
+      << ' ' << o.overdraw.max_sweeps << " seed " << o.seed << " lbg " << o.lbg_threshold << ' '
+      << o.lbg_max_iterations << " cpca " << o.cpca_threshold << ' ' << o.cpca_max_iterations << ' '
+      << o.cpca_candidates;
+  CacheResult r{cache_dir / ("cpca-" + hex(hash_text(key.str())) + ".prtc"), false};
+  if (fs::exists(r.path)) {
+    try {
+      const cpca::CompressedSet set = cpca::read_compressed_header(r.path);
+      if (set.transfer_hash != header.payload_checksum)
+        throw std::runtime_error("compressed from another bake");
+      r.hit = true;
+      return r;
+    } catch (const std::exception& e) {
+      discard(r.path, e);
+    }
+  }
+  prepare(cache_dir);
+  const prt::TransferSet transfer = prt::read_transfer(transfer_path);
+  cpca::write_compressed(r.path, run_compress(transfer, mesh, mesh_path, o, quiet));
+  return r;
+}
+
+}  // namespace prtr_app

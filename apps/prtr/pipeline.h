@@ -1,0 +1,54 @@
+// apps/prtr/pipeline.h: bake and compress as the commands run them (progress bar, memory
+// check, report on stderr), and a content-addressed cache so that prtr relight / overdraw /
+// render with the same inputs skip both.
+//
+// Cache: files in one directory (default $PRTR_CACHE, else $XDG_CACHE_HOME/prtr, else
+// ~/.cache/prtr), named by an FNV-1a hash of everything that determines them:
+//   bake-<hash>.prtx   mesh content hash + every bake option
+//   cpca-<hash>.prtc   transfer payload checksum + every compression option
+// Entries are written atomically, so an interrupted run leaves no entry (never half of one);
+// an entry that fails validation is reported, deleted and rebuilt.
+#pragma once
+
+#include "cpca/compress.h"
+#include "cpca/compressed.h"
+#include "meshes/mesh.h"
+#include "prt/bake.h"
+#include "prt/transfer.h"
+
+#include <filesystem>
+#include <string>
+
+namespace prtr_app {
+
+cpca::Geometry geometry_of(const meshes::Mesh& mesh);
+
+// Bakes with a progress bar (unless quiet) after checking the memory estimate; throws a
+// runtime_error naming the mesh when it would not fit.
+prt::TransferSet run_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
+                          prt::BakeOptions options, bool quiet, prt::BakeStats* stats = nullptr);
+
+// Compresses a transfer set of `mesh` (checked to match) with a progress bar; fills the
+// set's hashes and mesh path.
+cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes::Mesh& mesh,
+                                 const std::string& mesh_path, cpca::CompressOptions options,
+                                 bool quiet, cpca::CompressReport* report = nullptr);
+
+std::filesystem::path default_cache_dir();
+
+struct CacheResult {
+  std::filesystem::path path;
+  bool hit = false;
+};
+
+// The cached bake of `mesh` with `options`, baking it when missing or damaged.
+CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
+                        const prt::BakeOptions& options, const std::filesystem::path& cache_dir,
+                        bool quiet);
+
+// The cached compression of the transfer file `transfer_path`.
+CacheResult cached_compress(const std::filesystem::path& transfer_path, const meshes::Mesh& mesh,
+                            const std::string& mesh_path, const cpca::CompressOptions& options,
+                            const std::filesystem::path& cache_dir, bool quiet);
+
+}  // namespace prtr_app
