@@ -278,8 +278,14 @@ void write_picture_png(const fs::path& path, const Picture& picture) {
     throw ImageError("cannot write picture " + path.string() + ": directory " + dir.string() +
                      " does not exist; create it first");
   std::random_device rd;
-  const fs::path temp =
-      dir / ("." + path.stem().string() + ".tmp" + std::to_string(rd() % 1000000) + ".png");
+  // Built by appending: GCC 12 flags "." + std::string as an overlapping memcpy
+  // (-Wrestrict false positive).
+  std::string name = path.stem().string();
+  name.insert(name.begin(), '.');
+  name += ".tmp";
+  name += std::to_string(rd() % 1000000);
+  name += ".png";
+  const fs::path temp = dir / name;
   auto fail = [&](const std::string& why) {
     std::error_code ec;
     fs::remove(temp, ec);
