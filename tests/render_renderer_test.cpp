@@ -338,6 +338,24 @@ TEST(Renderer, BackgroundIsTheRotatedProbe) {
   EXPECT_EQ(solid.pixel(0, 0)[2], 0.75f);
 }
 
+TEST(Renderer, SolidBackgroundDoesNotLeakIntoAdditivePasses) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_torus(1.f, 0.4f, 16, 8), 3, 8, 2);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  const render::Background grey{false, render::Rgb(0.5f, 0.5f, 0.5f)};
+  auto image = [&](render::Mode mode) {
+    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, options(mode, 2 * registers));
+    r.set_background(grey);
+    r.render(s.camera, s.lighting, test_rotation());
+    return r.read_image();
+  };
+  const render::Image single = image(render::Mode::kSinglepass);
+  const render::Image multi = image(render::Mode::kMultipass);
+  EXPECT_LT(max_abs_difference(multi, single), kImageTolerance * single.max_rgb());
+  EXPECT_EQ(single.pixel(0, 0)[1], 0.5f);
+  EXPECT_EQ(single.pixel(0, 0)[3], 0.f);
+}
+
 // --- Compression error ---------------------------------------------------------------------
 
 TEST(Renderer, CompressedErrorFallsAsComponentsAndClustersGrow) {

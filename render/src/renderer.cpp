@@ -149,6 +149,7 @@ struct Renderer::Impl {
   void set_camera_uniforms(GlProgram& program, const Camera& camera);
   void shade_decoupled();
   void draw(const Camera& camera, const Eigen::Matrix3d& rotation_matrix);
+  void draw_background(const Camera& camera, const Eigen::Matrix3d& rotation_matrix);
   void draw_range(const Range& r) const {
     glDrawElements(GL_TRIANGLES, r.count, GL_UNSIGNED_INT,
                    reinterpret_cast<const void*>(r.first * sizeof(std::uint32_t)));
@@ -478,15 +479,15 @@ void Renderer::Impl::setup(const meshes::Mesh& source, const cpca::CompressedSet
   if (probe && probe->width() > 0) {
     tw = probe->width();
     th = probe->height();
-    texels.resize(std::size_t(tw) * th * 3);
+    texels.assign(std::size_t(tw) * th * 4, 1.f);
     for (std::size_t i = 0; i < probe->texels().size(); ++i)
-      for (int c = 0; c < 3; ++c) texels[i * 3 + c] = probe->texels()[i][c];
+      for (int c = 0; c < 3; ++c) texels[i * 4 + c] = probe->texels()[i][c];
     have_probe = true;
   } else {
-    texels.assign(6, 0.f);
+    texels.assign(8, 0.f);
   }
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, tw, th, 0, GL_RGB, GL_FLOAT, texels.data());
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, tw, th, 0, GL_RGBA, GL_FLOAT, texels.data());
   // Bilinear between texel centres, wrapping in u and clamping in v: Probe::lookup exactly.
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -579,7 +580,11 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
   glViewport(0, 0, camera.width, camera.height);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
-  glClearColor(0.f, 0.f, 0.f, 0.f);
+  // A solid background is the clear colour (alpha 0: not coverage); the multipass pre-pass
+  // writes (0, 0, 0, 1) over it wherever the mesh is, so the additive passes start at zero.
+  const bool probe_background = background.use_probe && have_probe;
+  const Rgb clear = probe_background ? Rgb::Zero() : background.colour;
+  glClearColor(clear.x(), clear.y(), clear.z(), 0.f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glEnable(GL_DEPTH_TEST);
@@ -601,7 +606,7 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
 
   if (mode == Mode::kMultipass) {
     set_camera_uniforms(depth_program, camera);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_TRUE);  // alpha = coverage
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);  // rgb = 0, alpha = coverage
     glDepthFunc(GL_LESS);
     draw_range(whole);
     set_camera_uniforms(shade_program, camera);
@@ -642,6 +647,13 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
   }
 
   // Background where no triangle wrote depth (depth is still the cleared 1.0).
+  if (probe_background) draw_background(camera, rotation_matrix);
+  glDepthMask(GL_TRUE);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glBindVertexArray(vao);
+}
+
+void Renderer::Impl::draw_background(const Camera& camera, const Eigen::Matrix3d& rotation_matrix) {
   glBindVertexArray(empty_vao);
   background_program.use();
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
@@ -657,20 +669,13 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
   glUniform3fv(background_program.uniform("u_forward"), 1, ff.data());
   glUniform3fv(background_program.uniform("u_right"), 1, rr.data());
   glUniform3fv(background_program.uniform("u_up"), 1, uu.data());
-  glUniform2f(background_program.uniform("u_viewport"), float(camera.width), float(camera.height));
   const Eigen::Matrix3f probe_from_world = rotation_matrix.transpose().cast<float>();
   glUniformMatrix3fv(background_program.uniform("u_probe_from_world"), 1, GL_FALSE,
                      probe_from_world.data());
-  glUniform1i(background_program.uniform("u_solid"), background.use_probe && have_probe ? 0 : 1);
-  const Rgb colour = background.use_probe ? Rgb::Zero() : background.colour;
-  glUniform3fv(background_program.uniform("u_colour"), 1, colour.data());
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, probe_texture);
   glUniform1i(background_program.uniform("u_probe"), 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  glDepthMask(GL_TRUE);
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-  glBindVertexArray(vao);
 }
 
 Renderer::Renderer(const meshes::Mesh& mesh, const cpca::CompressedSet* set,

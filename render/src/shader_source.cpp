@@ -205,31 +205,41 @@ std::string constant_fragment_shader() {
 }
 
 std::string background_vertex_shader() {
+  // The world ray direction f + x r + y u is affine in screen position, so interpolating it
+  // from the corners is exact and the fragment stage needs no per-pixel reconstruction.
   return std::string(kHeader) +
+         "uniform vec3 u_forward, u_right, u_up;  // right/up scaled by the half-fov tangents\n"
+         "out vec3 v_direction;\n"
          "void main() {\n"
          "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
+         "  v_direction = u_forward + p.x * u_right + p.y * u_up;\n"
          "  gl_Position = vec4(p, 1.0, 1.0);\n"
          "}\n";
 }
 
 std::string background_fragment_shader() {
+  // atan2 by a minimax polynomial (max error ~1e-5 rad, under 1/500 of a texel of a
+  // 1024-wide probe): llvmpipe's acos/atan made this pass cost more than the mesh.
   return std::string(kHeader) +
-         "uniform vec3 u_forward, u_right, u_up;  // right/up scaled by the half-fov tangents\n"
-         "uniform vec2 u_viewport;\n"
+         "in vec3 v_direction;\n"
          "uniform mat3 u_probe_from_world;\n"
-         "uniform int u_solid;\n"
-         "uniform vec3 u_colour;\n"
          "uniform sampler2D u_probe;\n"
          "layout(location = 0) out vec4 o_colour;\n"
          "const float kPi = 3.14159265358979;\n"
+         "float atan2_fast(float y, float x) {\n"
+         "  float ax = abs(x), ay = abs(y);\n"
+         "  float a = min(ax, ay) / max(max(ax, ay), 1e-30);\n"
+         "  float s = a * a;\n"
+         "  float r = ((-0.0464964749 * s + 0.15931422) * s - 0.327622764) * s * a + a;\n"
+         "  if (ay > ax) r = 0.5 * kPi - r;\n"
+         "  if (x < 0.0) r = kPi - r;\n"
+         "  return y < 0.0 ? -r : r;\n"
+         "}\n"
          "void main() {\n"
-         "  if (u_solid != 0) { o_colour = vec4(u_colour, 0.0); return; }\n"
-         "  vec2 ndc = 2.0 * gl_FragCoord.xy / u_viewport - 1.0;\n"
-         "  vec3 w = normalize(u_forward + ndc.x * u_right + ndc.y * u_up);\n"
-         "  vec3 d = normalize(u_probe_from_world * w);\n"
+         "  vec3 d = u_probe_from_world * v_direction;\n"
          "  // probes/probe.h: direction(u, v) = (-sin t sin p, cos t, sin t cos p).\n"
-         "  float theta = acos(clamp(d.y, -1.0, 1.0));\n"
-         "  float phi = atan(-d.x, d.z);\n"
+         "  float theta = atan2_fast(length(d.xz), d.y);\n"
+         "  float phi = atan2_fast(-d.x, d.z);\n"
          "  if (phi < 0.0) phi += 2.0 * kPi;\n"
          "  o_colour = vec4(texture(u_probe, vec2(phi / (2.0 * kPi), theta / kPi)).rgb, 0.0);\n"
          "}\n";

@@ -55,8 +55,8 @@ std::string radiance_fragment_shader();  // vec4(v_radiance, 1)
 std::string coverage_fragment_shader();  // vec4(0, 0, 0, 1): alpha = coverage
 std::string constant_fragment_shader();  // uniform u_colour, alpha 1
 
-// Full-screen triangle at depth 1 and the lat-long probe lookup (probes/probe.h convention)
-// or a solid colour; alpha 0 (background is not coverage).
+// Full-screen triangle at depth 1 and the lat-long probe lookup (probes/probe.h
+// convention); alpha 0 (background is not coverage). Solid colours are the clear colour.
 std::string background_vertex_shader();
 std::string background_fragment_shader();
 

@@ -1,0 +1,88 @@
+#include "render/floor_harness.h"
+
+#include "gl_program.h"
+#include "render/gl_context.h"
+#include "render/shader_source.h"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+namespace render {
+
+double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const FloorOptions& options) {
+  camera.validate();
+  std::vector<std::uint32_t> indices;
+  indices.reserve(mesh.triangle_count() * 3);
+  for (const auto& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
+  if (options.optimize_vertex_cache) {
+    std::vector<std::uint32_t> optimised(indices.size());
+    meshopt_optimizeVertexCache(optimised.data(), indices.data(), indices.size(),
+                                mesh.vertex_count());
+    indices.swap(optimised);
+  }
+  GLuint vao = 0, vbo = 0, ibo = 0, fbo = 0, rb[2] = {0, 0};
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glGenBuffers(1, &vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.vertex_count() * 12), mesh.positions.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(kAttrPosition);
+  glVertexAttribPointer(kAttrPosition, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+  glGenBuffers(1, &ibo);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(),
+               GL_STATIC_DRAW);
+  glGenFramebuffers(1, &fbo);
+  glGenRenderbuffers(2, rb);
+  glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, camera.width, camera.height);
+  glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, camera.width, camera.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+  GlProgram program("floor", position_vertex_shader(), constant_fragment_shader());
+  program.use();
+  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
+  glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
+  glUniform3f(program.uniform("u_colour"), 0.5f, 0.5f, 0.5f);
+  glViewport(0, 0, camera.width, camera.height);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+  if (options.cull_back_faces) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
+  std::vector<double> ms;
+  for (int f = -options.warmup; f < options.frames; ++f) {
+    const auto start = std::chrono::steady_clock::now();
+    glClearColor(0.f, 0.f, 0.f, 0.f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDrawElements(GL_TRIANGLES, GLsizei(indices.size()), GL_UNSIGNED_INT, nullptr);
+    glFinish();
+    if (f >= 0)
+      ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
+  }
+  check_gl("floor_frame_ms");
+  glDisable(GL_CULL_FACE);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  glDeleteFramebuffers(1, &fbo);
+  glDeleteRenderbuffers(2, rb);
+  glDeleteBuffers(1, &vbo);
+  glDeleteBuffers(1, &ibo);
+  glDeleteVertexArrays(1, &vao);
+  std::sort(ms.begin(), ms.end());
+  const std::size_t n = ms.size();
+  return n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+}
+
+}  // namespace render
