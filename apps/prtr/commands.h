@@ -17,6 +17,7 @@ Runner add_gl_info_command(CLI::App& app);
 Runner add_bake_command(CLI::App& app);
 Runner add_info_command(CLI::App& app);
 Runner add_compress_command(CLI::App& app);
+Runner add_relight_command(CLI::App& app);
 Runner add_overdraw_command(CLI::App& app);
 Runner add_render_command(CLI::App& app);
 

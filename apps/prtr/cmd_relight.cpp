@@ -1,0 +1,246 @@
+// prtr relight MESH --probe PROBE: the whole pipeline in one command. Bakes and compresses
+// through the cache (a second run with the same inputs skips both), then renders a frame
+// sequence while the environment turns about an axis (SH rotation per frame, no
+// re-projection), writing EXR frames, PNG previews, a contact sheet and, when ffmpeg is
+// installed, an MP4.
+#include "bake_flags.h"
+#include "commands.h"
+#include "contact_sheet.h"
+#include "cpca/compressed_file.h"
+#include "meshes/load.h"
+#include "pass_grouping.h"
+#include "pipeline.h"
+#include "probes/load.h"
+#include "progress_bar.h"
+#include "prt/projection.h"
+#include "prt/sh_rotation.h"
+#include "render/gl_context.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "view_flags.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <numbers>
+#include <optional>
+#include <regex>
+#include <string>
+#include <vector>
+
+namespace prtr_app {
+namespace fs = std::filesystem;
+namespace {
+
+std::string frame_name(int index, const char* extension) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "frame_%04d.%s", index, extension);
+  return buf;
+}
+
+// Frames of an earlier, longer run would mix into the sequence (and the video): remove
+// files named exactly like ours, nothing else.
+void remove_old_frames(const fs::path& dir) {
+  static const std::regex pattern("frame_[0-9]{4}\\.(exr|png)");
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (std::regex_match(entry.path().filename().string(), pattern)) fs::remove(entry.path(), ec);
+}
+
+bool have_ffmpeg() {
+  return std::system("command -v ffmpeg >/dev/null 2>&1") == 0;
+}
+
+// Encodes the PNG previews; the MP4 appears under its name only when ffmpeg succeeded.
+bool encode_video(const fs::path& dir, const fs::path& output, int fps) {
+  const fs::path temporary = dir / ".relight.tmp.mp4";
+  const std::string command = "ffmpeg -y -loglevel error -framerate " + std::to_string(fps) +
+                              " -i '" + (dir / "frame_%04d.png").string() +
+                              "' -vf 'scale=trunc(iw/2)*2:trunc(ih/2)*2' -pix_fmt yuv420p '" +
+                              temporary.string() + "'";
+  const bool ok = std::system(command.c_str()) == 0;
+  std::error_code ec;
+  if (ok) fs::rename(temporary, output, ec);
+  fs::remove(temporary, ec);
+  return ok && !ec;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+}  // namespace
+
+Runner add_relight_command(CLI::App& app) {
+  struct Options {
+    std::string mesh, probe, out = "out/relight", cache, mode = "multipass";
+    std::string strategy = "greedy-refine", method = "lbg";
+    BakeFlags bake;
+    ViewFlags view;
+    cpca::CompressOptions compress;
+    int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0;
+    double degrees = 360.0;
+    bool quiet = false, no_video = false;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "relight",
+      "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
+      "previews, a contact sheet and an MP4");
+  cmd->add_option("MESH", opt->mesh, "Mesh file (OBJ, PLY, OFF, STL)")->required();
+  cmd->add_option("--probe", opt->probe, "Light probe (lat-long or angular EXR/HDR)")->required();
+  cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
+  cmd->add_option("--frames", opt->frames, "Frames in the sequence")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--degrees", opt->degrees, "Total environment rotation over the sequence")
+      ->capture_default_str();
+  cmd->add_option("--mode", opt->mode, "Rendering path (render/renderer.h)")
+      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}))
+      ->capture_default_str();
+  cmd->add_option("--strategy", opt->strategy, "Super-cluster strategy for multipass/decoupled")
+      ->capture_default_str();
+  cmd->add_option("--register-budget", opt->register_budget,
+                  "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--clusters", opt->compress.clusters, "CPCA clusters")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--pcs", opt->compress.components, "Principal components per cluster")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--method", opt->method, "lbg or iterative (CPCA)")
+      ->check(CLI::IsMember({"lbg", "iterative"}))
+      ->capture_default_str();
+  cmd->add_option("--alpha", opt->compress.alpha, "Geometry-coherence weight (0: off)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  cmd->add_flag("--overdraw-reduction", opt->compress.overdraw_reduction,
+                "Overdraw-aware reassignment after clustering");
+  add_bake_flags(cmd, opt->bake);
+  add_view_flags(cmd, opt->view);
+  cmd->add_option("--cache", opt->cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
+  cmd->add_option("--columns", opt->columns, "Contact sheet columns")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  cmd->add_option("--thumbnail", opt->thumbnail, "Contact sheet thumbnail width (pixels)")
+      ->check(CLI::Range(16, 4096))
+      ->capture_default_str();
+  cmd->add_option("--fps", opt->fps, "Video frame rate")
+      ->check(CLI::Range(1, 240))
+      ->capture_default_str();
+  cmd->add_flag("--no-video", opt->no_video, "Do not encode an MP4 even if ffmpeg is installed");
+  cmd->add_flag("-q,--quiet", opt->quiet, "No progress bars");
+
+  return [opt] {
+    Options& o = *opt;
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    const prt::BakeOptions bake = resolve_bake_flags(o.bake);
+    o.compress.method =
+        o.method == "iterative" ? cpca::ClusterMethod::kIterative : cpca::ClusterMethod::kLbg;
+    const Eigen::Vector3d axis = resolve_axis(o.view);
+    const render::Background background = resolve_background(o.view);
+    const int n = bake.order * bake.order;
+    const std::size_t dimension = std::size_t(bake.material.channels()) * std::size_t(n) *
+                                  std::size_t(bake.kind == prt::TransferKind::kGlossy ? n : 1);
+    if (std::size_t(o.compress.components) >= dimension)
+      throw UsageError("--pcs " + std::to_string(o.compress.components) +
+                       " must be below the transfer dimension " + std::to_string(dimension) +
+                       " (order " + std::to_string(bake.order) + ")");
+
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    if (std::size_t(o.compress.clusters) > mesh.vertex_count())
+      throw UsageError("--clusters " + std::to_string(o.compress.clusters) + " exceeds the " +
+                       std::to_string(mesh.vertex_count()) + " vertices of " + o.mesh);
+    const render::Camera camera = resolve_camera(o.view, mesh);
+    const probes::Probe probe = probes::load_probe(o.probe);  // fail before the long work
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (ec)
+      throw std::runtime_error("output directory " + o.out + " cannot be created (" + ec.message() +
+                               "); choose another --out");
+
+    const fs::path cache = o.cache.empty() ? default_cache_dir() : fs::path(o.cache);
+    const auto t_bake = Clock::now();
+    const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
+    const double bake_s = std::chrono::duration<double>(Clock::now() - t_bake).count();
+    const auto t_compress = Clock::now();
+    const CacheResult compressed =
+        cached_compress(transfer.path, mesh, o.mesh, o.compress, cache, o.quiet);
+    const double compress_s = std::chrono::duration<double>(Clock::now() - t_compress).count();
+    std::printf("bake        %s %s (%.1f s)\n", transfer.hit ? "cached" : "baked",
+                transfer.path.string().c_str(), bake_s);
+    std::printf("compress    %s %s (%.1f s)\n", compressed.hit ? "cached" : "compressed",
+                compressed.path.string().c_str(), compress_s);
+
+    const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
+    const prt::ShLighting lighting = prt::project(probe, set.order);
+    render::GlContext context;
+    render::RendererOptions ro;
+    ro.mode = render::parse_mode(o.mode);
+    ro.register_budget = o.register_budget;
+    if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
+      ro.groups = group_for_renderer(mesh, set, context, o.register_budget, 0, o.strategy);
+    std::optional<render::Renderer> renderer;
+    try {
+      renderer.emplace(mesh, &set, nullptr, &probe, ro);
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    renderer->set_background(background);
+    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+    for (int i = 0; i < 2; ++i) renderer->render(camera, lighting, identity);  // warm-up
+
+    remove_old_frames(o.out);
+    ProgressBar bar(o.quiet);
+    std::vector<double> frame_ms, gl_ms, cpu_ms;
+    std::vector<render::Image> thumbnails;
+    const auto t_frames = Clock::now();
+    for (int f = 0; f < o.frames; ++f) {
+      bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
+      const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
+      const render::FrameTiming t =
+          renderer->render(camera, lighting, prt::axis_angle(axis, angle));
+      frame_ms.push_back(t.total_ms);
+      gl_ms.push_back(t.gl_ms);
+      cpu_ms.push_back(t.cpu_ms);
+      const render::Image image = renderer->read_image();
+      render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
+      render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
+      thumbnails.push_back(downscale(image, o.thumbnail));
+    }
+    bar.finish();
+    const double frames_s = std::chrono::duration<double>(Clock::now() - t_frames).count();
+    const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
+    render::write_png(sheet, tile(thumbnails, o.columns), o.view.exposure);
+    std::string video = "skipped (--no-video)";
+    if (!o.no_video) {
+      const fs::path mp4 = fs::path(o.out) / "relight.mp4";
+      if (!have_ffmpeg())
+        video = "skipped (ffmpeg is not installed)";
+      else
+        video =
+            encode_video(o.out, mp4, o.fps) ? mp4.string() : "failed (ffmpeg reported an error)";
+    }
+    const render::RenderStats& st = renderer->stats();
+    std::printf("render      %s, %d pass(es), average overdraw %.3f, %d x %d\n", o.mode.c_str(),
+                st.passes, st.average_overdraw, camera.width, camera.height);
+    std::printf(
+        "frames      %d in %s: %.2f ms per frame median (%.1f FPS; CPU update %.2f ms, "
+        "GL %.2f ms), %.2f s with EXR/PNG output\n",
+        o.frames, o.out.c_str(), median(frame_ms), 1000.0 / median(frame_ms), median(cpu_ms),
+        median(gl_ms), frames_s);
+    std::printf("video       %s\n", video.c_str());
+    std::printf("total       %.1f s\n",
+                std::chrono::duration<double>(Clock::now() - start).count());
+    std::printf("contact sheet: %s\n", sheet.string().c_str());
+  };
+}
+
+}  // namespace prtr_app

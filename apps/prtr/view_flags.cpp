@@ -1,0 +1,83 @@
+#include "view_flags.h"
+
+#include "commands.h"
+
+#include <sstream>
+#include <vector>
+
+namespace prtr_app {
+
+void add_view_flags(CLI::App* cmd, ViewFlags& f) {
+  cmd->add_option("--width", f.width, "Image width")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--height", f.height, "Image height")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--eye", f.eye, "Camera position x,y,z (default: frames the bounding sphere)");
+  cmd->add_option("--target", f.target, "Camera target x,y,z (default: the sphere's centre)");
+  cmd->add_option("--up", f.up, "Camera up x,y,z (default: 0,1,0)");
+  cmd->add_option("--fov", f.fov, "Vertical field of view (degrees)")->capture_default_str();
+  cmd->add_option("--background", f.background, "probe, black, or a colour R,G,B")
+      ->capture_default_str();
+  cmd->add_option("--exposure", f.exposure, "PNG exposure in stops")->capture_default_str();
+  cmd->add_option("--axis", f.axis, "Environment rotation axis x,y,z")->capture_default_str();
+}
+
+Eigen::Vector3d parse_vector(const std::string& text, const char* flag) {
+  std::vector<double> values;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError(std::string(flag) + ": '" + text + "' is not a list of numbers");
+    }
+  }
+  if (values.size() != 3)
+    throw UsageError(std::string(flag) + " takes 3 comma-separated numbers x,y,z, got '" + text +
+                     "'");
+  return {values[0], values[1], values[2]};
+}
+
+render::Camera resolve_camera(const ViewFlags& f, const meshes::Mesh& mesh) {
+  const Eigen::Vector3d centre = meshes::bounds(mesh).center().cast<double>();
+  double radius = 0.0;
+  for (const auto& p : mesh.positions)
+    radius = std::max(radius, (p.cast<double>() - centre).norm());
+  render::Camera camera = render::frame_sphere(centre, radius, f.width, f.height, f.fov);
+  if (!f.target.empty()) camera.target = parse_vector(f.target, "--target");
+  if (!f.eye.empty()) camera.eye = parse_vector(f.eye, "--eye");
+  if (!f.up.empty()) camera.up = parse_vector(f.up, "--up");
+  render::fit_clip_planes(camera, centre, radius);
+  try {
+    camera.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return camera;
+}
+
+render::Background resolve_background(const ViewFlags& f) {
+  render::Background background;
+  if (f.background == "probe") {
+    background.use_probe = true;
+  } else if (f.background == "black") {
+    background.use_probe = false;
+  } else {
+    background.use_probe = false;
+    background.colour = parse_vector(f.background, "--background").cast<float>();
+  }
+  return background;
+}
+
+Eigen::Vector3d resolve_axis(const ViewFlags& f) {
+  const Eigen::Vector3d axis = parse_vector(f.axis, "--axis");
+  if (!(axis.norm() > 0)) throw UsageError("--axis must not be the zero vector");
+  return axis.normalized();
+}
+
+}  // namespace prtr_app
