@@ -77,7 +77,7 @@ double median(std::vector<double> v) {
 
 Runner add_relight_command(CLI::App& app) {
   struct Options {
-    std::string mesh, probe, out = "out/relight", cache, mode = "multipass";
+    std::string mesh, probe, out = "out/relight", cache, mode = "decoupled";
     std::string strategy = "greedy-refine", method = "lbg";
     BakeFlags bake;
     ViewFlags view;
