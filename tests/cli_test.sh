@@ -152,5 +152,34 @@ if [[ -f $forest ]]; then
   run overdraw "$tmp/cube.obj" --probe "$forest" --transfer "$tmp/cube.prtx" --order 3; expect_code 2 && [[ $err == *--order* ]]; check "overdraw: bake flag with --transfer is a usage error" $?
 fi
 
+# prtr relight on the cube at 64 x 32 (2:1, so prtr probe can decode the frames as lat-long
+# maps and report their mean): outputs exist, decode, are lit; the second run is cached.
+if [[ -f $forest ]]; then
+  rl=(relight "$tmp/cube.obj" --probe "$forest" --order 2 --samples 32 --bounces 0 --clusters 2
+      --pcs 2 --frames 3 --width 64 --height 32 --background black --cache "$tmp/rl_cache"
+      --out "$tmp/rl" --no-video -q)
+  run "${rl[@]}"; expect_code 0; check "relight: exits 0 ($err)" $?
+  [[ $out == *"bake        baked"* && $out == *"compress    compressed"* ]]; check "relight: first run bakes and compresses" $?
+  [[ $out =~ contact\ sheet:\ (.*contact_sheet.png) && -s ${BASH_REMATCH[1]} ]]; check "relight: prints the contact sheet's path" $?
+  [[ $(head -c 8 "$tmp/rl/contact_sheet.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]]; check "relight: contact sheet is a PNG" $?
+  for f in 0 1 2; do
+    run probe "$tmp/rl/frame_000$f.exr" --order 1; expect_code 0; check "relight: frame $f EXR decodes" $?
+    [[ $out =~ mean\ +\(([0-9.e+-]+), ]] && awk -v m="${BASH_REMATCH[1]}" 'BEGIN { exit !(m > 0.001) }'; check "relight: frame $f is lit (mean ${BASH_REMATCH[1]:-none})" $?
+    run probe "$tmp/rl/frame_000$f.png" --order 1; expect_code 0; check "relight: frame $f PNG decodes" $?
+  done
+  [[ ! -e $tmp/rl/frame_0003.exr ]]; check "relight: exactly 3 frames" $?
+  run "${rl[@]}"; expect_code 0 && [[ $out == *"bake        cached"* && $out == *"compress    cached"* ]]; check "relight: second run uses the cache" $?
+  for entry in "$tmp"/rl_cache/cpca-*.prtc; do head -c 200 "$entry" >"$entry.cut" && mv "$entry.cut" "$entry"; done
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable* && $out == *"compress    compressed"* ]]; check "relight: a damaged cache entry is reported and rebuilt" $?
+  run relight "$tmp/missing.obj" --probe "$forest" --out "$tmp/rl2"; expect_code 1 && [[ $err == *missing.obj* ]]; check "relight: missing mesh exits 1 naming it" $?
+  run relight "$tmp/cube.obj" --probe "$tmp/garbage.exr" --clusters 2 --out "$tmp/rl2"; expect_code 1 && [[ $err == *garbage.exr* ]]; check "relight: unreadable probe exits 1 naming it" $?
+  ! ls "$tmp"/rl2/frame_* >/dev/null 2>&1; check "relight: failures leave no frames" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --clusters 9 --order 2; expect_code 2 && [[ $err == *--clusters* ]]; check "relight: clusters > vertices is a usage error" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --clusters 2 --order 2 --pcs 16; expect_code 2 && [[ $err == *--pcs* ]]; check "relight: PCs >= dimension is a usage error" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --order 0; expect_code 2; check "relight: order 0 is a usage error" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --order 11; expect_code 2; check "relight: order 11 is a usage error" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --axis 0,0,0; expect_code 2 && [[ $err == *--axis* ]]; check "relight: zero axis is a usage error" $?
+fi
+
 echo "cli: $passed passed, $failed failed"
 ((failed == 0))
