@@ -42,8 +42,9 @@ struct PcaResult {
 PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& centred, int k,
                               const PowerIterationOptions& options = {});
 
-// The same result from Eigen's SelfAdjointEigenSolver: the oracle for tests and the
-// `--pca eigen` option.
+// The same result from Eigen's SelfAdjointEigenSolver (on the Gram matrix when m < n, as
+// above): the oracle for tests and the `--pca eigen` option. Directions past the data's rank
+// (eigenvalue below 1e-12 of the largest) are zero rows, as in power_iteration_pca.
 PcaResult eigen_pca(const Eigen::Ref<const Eigen::MatrixXd>& centred, int k);
 
 }  // namespace cpca
