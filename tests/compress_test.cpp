@@ -4,6 +4,8 @@
 #include "cpca/compress.h"
 #include "cpca/cluster_pca.h"
 
+#include "cpca_test_support.h"
+
 #include <gtest/gtest.h>
 #include <Eigen/QR>
 
@@ -11,6 +13,8 @@
 #include <set>
 
 namespace {
+
+using cpca_test::grid;
 
 // K affine subspaces of dimension `rank` in R^d, far apart: point = offset_k + U_k c.
 cpca::DataMatrix affine_subspaces(int k, int per, int rank, int d, unsigned seed,
@@ -34,21 +38,6 @@ cpca::DataMatrix affine_subspaces(int k, int per, int rank, int d, unsigned seed
     }
   }
   return x;
-}
-
-cpca::Geometry grid(int n) {
-  cpca::Geometry g;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      g.positions.emplace_back(float(x) / (n - 1), float(y) / (n - 1), 0.f);
-  for (int y = 0; y + 1 < n; ++y)
-    for (int x = 0; x + 1 < n; ++x) {
-      const std::uint32_t a = std::uint32_t(y * n + x), b = a + 1, c = a + std::uint32_t(n),
-                          d = c + 1;
-      g.triangles.push_back({a, b, d});
-      g.triangles.push_back({a, d, c});
-    }
-  return g;
 }
 
 TEST(Compress, AffineSubspacesAreRecoveredExactly) {

@@ -4,6 +4,8 @@
 #include "cpca/assignment.h"
 #include "cpca/kd_tree.h"
 
+#include "cpca_test_support.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +13,8 @@
 #include <set>
 
 namespace {
+
+using cpca_test::grid;
 
 cpca::DataMatrix random_data(int rows, int cols, unsigned seed, float scale = 1.f) {
   std::mt19937 rng(seed);
@@ -27,22 +31,6 @@ cpca::DataMatrix blobs(int per_blob, int blobs, int cols, unsigned seed) {
   for (int b = 0; b < blobs; ++b)
     for (int i = 0; i < per_blob; ++i) x(b * per_blob + i, b % cols) += 10.f * float(1 + b / cols);
   return x;
-}
-
-// A regular n x n vertex grid on the unit square, two triangles per cell.
-cpca::Geometry grid(int n) {
-  cpca::Geometry g;
-  for (int y = 0; y < n; ++y)
-    for (int x = 0; x < n; ++x)
-      g.positions.emplace_back(float(x) / (n - 1), float(y) / (n - 1), 0.f);
-  for (int y = 0; y + 1 < n; ++y)
-    for (int x = 0; x + 1 < n; ++x) {
-      const std::uint32_t a = std::uint32_t(y * n + x), b = a + 1, c = a + std::uint32_t(n),
-                          d = c + 1;
-      g.triangles.push_back({a, b, d});
-      g.triangles.push_back({a, d, c});
-    }
-  return g;
 }
 
 TEST(KdTree, NearestMatchesBruteForceWithRadiusAndExclusion) {

@@ -14,6 +14,7 @@
 // hash and every bake parameter; compressed sets too, keyed by the bake's payload checksum
 // and every compression parameter, with the clustering time measured when they were made.
 #include "commands.h"
+#include "pipeline.h"
 
 #include "common/atomic_file.h"
 #include "common/hash.h"
@@ -166,14 +167,6 @@ std::uint64_t compress_key(std::uint64_t transfer_hash, const cpca::CompressOpti
   h = mix(h, c.cpca_threshold);
   h = mix(h, c.cpca_max_iterations);
   return h;
-}
-
-cpca::Geometry geometry_of(const meshes::Mesh& mesh) {
-  cpca::Geometry g;
-  g.positions = mesh.positions;
-  g.triangles.reserve(mesh.triangles.size());
-  for (const meshes::Triangle& t : mesh.triangles) g.triangles.push_back({t[0], t[1], t[2]});
-  return g;
 }
 
 // RMSE over pixels both images cover (alpha > 0.5), averaged over R, G, B, and the

@@ -1,5 +1,7 @@
 #include "cpca/lbg.h"
 
+#include "splitmix.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -10,14 +12,7 @@
 namespace cpca {
 namespace {
 
-// splitmix64: a small, portable generator (std distributions differ between libraries).
-double next_uniform(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return double(z >> 11) * 0x1.0p-53;
-}
+using detail::next_uniform;
 
 DataMatrix hyper_box_means(const Eigen::Ref<const DataMatrix>& x, int k, std::uint64_t seed) {
   const Eigen::RowVectorXf lo = x.colwise().minCoeff(), hi = x.colwise().maxCoeff();

@@ -2,6 +2,8 @@
 // deliberate differences from the printed listing.
 #include "cpca/power_iteration.h"
 
+#include "splitmix.h"
+
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -21,14 +23,7 @@ void check_k(const Eigen::Ref<const Eigen::MatrixXd>& f, int k) {
   }
 }
 
-// A small deterministic generator (splitmix64) for the start vectors.
-double next_uniform(std::uint64_t& state) {
-  std::uint64_t z = (state += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return double(z >> 11) * 0x1.0p-53;
-}
+using detail::next_uniform;
 
 }  // namespace
 
