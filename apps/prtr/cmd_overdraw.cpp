@@ -13,6 +13,7 @@
 // Caching (stated in the output): the bake is cached in --cache keyed by the mesh content
 // hash and every bake parameter; compressed sets too, keyed by the bake's payload checksum
 // and every compression parameter, with the clustering time measured when they were made.
+#include "bake_flags.h"
 #include "commands.h"
 #include "pipeline.h"
 
@@ -82,22 +83,6 @@ std::vector<int> parse_clusters(const std::string& text) {
   return out;
 }
 
-Eigen::Vector3f parse_grey_or_rgb(const std::string& text) {
-  std::vector<float> v;
-  for (const std::string& item : split_list(text, "--albedo")) {
-    std::size_t used = 0;
-    try {
-      v.push_back(std::stof(item, &used));
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size()) throw UsageError("--albedo: '" + text + "' is not a number list");
-  }
-  if (v.size() == 1) return Eigen::Vector3f::Constant(v[0]);
-  if (v.size() == 3) return {v[0], v[1], v[2]};
-  throw UsageError("--albedo takes one value (grey) or three (R,G,B), got '" + text + "'");
-}
-
 // The method rows: the thesis's four, and iterative CPCA with both (ours).
 struct MethodPreset {
   const char* name;
@@ -132,23 +117,6 @@ std::string hex16(std::uint64_t v) {
 template <class T>
 std::uint64_t mix(std::uint64_t h, const T& value) {
   return common::fnv1a(&value, sizeof value, h);
-}
-
-std::uint64_t bake_key(std::uint64_t mesh_hash, const prt::BakeOptions& b) {
-  std::uint64_t h = mix(common::kFnvOffset, mesh_hash);
-  h = mix(h, int(b.kind));
-  h = mix(h, b.order);
-  h = mix(h, b.samples);
-  h = mix(h, b.bounces);
-  h = mix(h, b.seed);
-  h = mix(h, int(b.material.kind));
-  h = common::fnv1a(b.material.albedo.data(), 3 * sizeof(float), h);
-  h = mix(h, b.material.specular);
-  h = mix(h, b.material.exponent);
-  h = mix(h, b.material.roughness);
-  h = mix(h, b.material.f0);
-  h = mix(h, b.ray_offset);
-  return h;
 }
 
 std::uint64_t compress_key(std::uint64_t transfer_hash, const cpca::CompressOptions& c) {
@@ -201,13 +169,12 @@ void write_text(const fs::path& path, const std::string& text) {
 
 Runner add_overdraw_command(CLI::App& app) {
   struct Options {
-    std::string mesh, probe, transfer, cache = "out/cache", out = "out/overdraw";
+    std::string mesh, probe, transfer, cache, out = "out/overdraw";
     std::string clusters = "64,128,192,256", rows = "original,overdraw-reduction,coherence,both";
     std::string strategies = "order,greedy,greedy-refine,metis,ils", budgets = "default,thesis";
     int pcs = 8, frames = 10, warmup = 2, width = 1280, height = 948;
     double alpha = 0.05, tolerance = 1.0, degrees_per_frame = 1.0, image_degrees = 37.0;
-    std::string kind = "glossy", material = "phong", albedo = "0.5";
-    prt::BakeOptions bake;
+    BakeFlags flags;
     bool json = false, quiet = false, recompress = false, no_modes = false;
   };
   auto opt = std::make_shared<Options>();
@@ -220,8 +187,9 @@ Runner add_overdraw_command(CLI::App& app) {
   cmd->add_option("--transfer", opt->transfer,
                   "Bake of MESH (.prtx); without it the mesh is baked with the bake flags and "
                   "cached in --cache");
-  cmd->add_option("--cache", opt->cache, "Directory of cached bakes and compressions")
-      ->capture_default_str();
+  cmd->add_option("--cache", opt->cache,
+                  "Directory of cached bakes and compressions (default $PRTR_CACHE or "
+                  "~/.cache/prtr, shared with prtr relight)");
   cmd->add_flag("--recompress", opt->recompress, "Ignore cached compressions (still writes them)");
   cmd->add_option("--clusters", opt->clusters, "Cluster counts K, comma separated")
       ->capture_default_str();
@@ -265,32 +233,8 @@ Runner add_overdraw_command(CLI::App& app) {
   cmd->add_flag("--no-modes", opt->no_modes, "Skip the single-pass/decoupled/uncompressed timings");
   cmd->add_flag("--json", opt->json, "Print the JSON report on stdout instead of the tables");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress on stderr");
-  // Bake flags (used only when there is no --transfer).
-  cmd->add_option("--kind", opt->kind, "Bake: diffuse or glossy")
-      ->check(CLI::IsMember({"diffuse", "glossy"}))
-      ->capture_default_str();
-  cmd->add_option("--order", opt->bake.order, "Bake: SH order")
-      ->check(CLI::Range(1, 10))
-      ->capture_default_str();
-  cmd->add_option("--samples", opt->bake.samples, "Bake: hemisphere directions per vertex")
-      ->check(CLI::Range(1, 65536))
-      ->capture_default_str();
-  cmd->add_option("--bounces", opt->bake.bounces, "Bake: interreflection passes")
-      ->check(CLI::Range(0, 16))
-      ->capture_default_str();
-  cmd->add_option("--material", opt->material, "Bake: lambert, phong or cook-torrance")
-      ->check(CLI::IsMember({"lambert", "phong", "cook-torrance"}))
-      ->capture_default_str();
-  cmd->add_option("--albedo", opt->albedo, "Bake: diffuse albedo, grey or R,G,B")
-      ->capture_default_str();
-  cmd->add_option("--specular", opt->bake.material.specular, "Bake: specular reflectance")
-      ->capture_default_str();
-  cmd->add_option("--exponent", opt->bake.material.exponent, "Bake: Phong exponent")
-      ->capture_default_str();
-  cmd->add_option("--roughness", opt->bake.material.roughness, "Bake: Cook-Torrance roughness")
-      ->capture_default_str();
-  cmd->add_option("--f0", opt->bake.material.f0, "Bake: Cook-Torrance Fresnel f0")
-      ->capture_default_str();
+  // Bake flags (used only when there is no --transfer), shared with prtr bake and relight.
+  add_bake_flags(cmd, opt->flags);
 
   return [opt, cmd] {
     Options& o = *opt;
@@ -319,6 +263,7 @@ Runner add_overdraw_command(CLI::App& app) {
                            " is a bake flag; it does not apply with --transfer (drop one)");
     }
 
+    if (o.cache.empty()) o.cache = default_cache_dir().string();
     ProgressBar bar(o.quiet);
     auto note = [&](const std::string& text) {
       if (o.quiet) return;
@@ -342,34 +287,12 @@ Runner add_overdraw_command(CLI::App& app) {
       report.transfer = o.transfer;
       report.bake_cached = true;
     } else {
-      o.bake.kind = o.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;
-      o.bake.material.kind = prt::parse_material(o.material);
-      o.bake.material.albedo = parse_grey_or_rgb(o.albedo);
-      if (o.bake.material.kind == prt::MaterialKind::kLambert) o.bake.material.specular = 0.f;
-      try {
-        prt::validate(o.bake);
-      } catch (const std::invalid_argument& e) {
-        throw UsageError(e.what());
-      }
-      fs::create_directories(o.cache);
-      const fs::path cached = fs::path(o.cache) / (fs::path(o.mesh).stem().string() + "-" +
-                                                   hex16(bake_key(mesh_hash, o.bake)) + ".prtx");
-      report.transfer = cached.string();
-      if (fs::exists(cached)) {
-        note("bake cached: " + cached.string());
-        transfer = prt::read_transfer(cached);
-        report.bake_cached = true;
-      } else {
-        note("baking " + o.mesh + " (cached afterwards as " + cached.string() + ")");
-        o.bake.progress = [&bar](const prt::BakeProgress& p) {
-          bar.update(p.pass == 0 ? "bake: shadow pass" : "bake: bounce " + std::to_string(p.pass),
-                     p.done, p.total);
-        };
-        transfer = prt::bake(mesh, o.bake);
-        o.bake.progress = nullptr;
-        prt::write_transfer(cached, transfer);
-        transfer = prt::read_transfer(cached);  // for its payload checksum
-      }
+      const CacheResult cached =
+          cached_bake(mesh, o.mesh, resolve_bake_flags(o.flags), o.cache, o.quiet);
+      note(std::string(cached.hit ? "bake cached: " : "baked, cached as ") + cached.path.string());
+      report.transfer = cached.path.string();
+      report.bake_cached = cached.hit;
+      transfer = prt::read_transfer(cached.path);
     }
     for (int k : ks)
       if (std::uint64_t(k) > transfer.vertex_count)
