@@ -10,6 +10,7 @@
 #include "cpca/compressed_file.h"
 
 #include "common/atomic_file.h"
+#include "common/binary_file.h"
 #include "common/hash.h"
 
 #include <array>
@@ -72,25 +73,6 @@ constexpr std::uint64_t kMaxVertexCount = std::uint64_t(1) << 40;
 constexpr const char* kRecompress = "compress it again with prtr compress";
 
 using Header = std::array<unsigned char, kHeaderBytes>;
-
-template <class T>
-void put(Header& h, std::size_t offset, T value) {
-  static_assert(std::is_trivially_copyable_v<T>);
-  std::memcpy(h.data() + offset, &value, sizeof(T));
-}
-
-template <class T>
-T get(const Header& h, std::size_t offset) {
-  T value;
-  std::memcpy(&value, h.data() + offset, sizeof(T));
-  return value;
-}
-
-std::string hex(std::uint64_t v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
-  return buf;
-}
 
 std::string num(double v) {
   char buf[48];
@@ -276,44 +258,30 @@ std::string value_problem(const CompressedSet& set) {
 Header encode_header(const CompressedSet& set, const Sizes& sizes) {
   Header h{};
   std::memcpy(h.data() + kOffMagic, kMagic.data(), kMagic.size());
-  put<std::uint32_t>(h, kOffVersion, kCompressedFileVersion);
-  put<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
-  put<std::uint32_t>(h, kOffOrder, std::uint32_t(set.order));
-  put<std::uint32_t>(h, kOffChannels, std::uint32_t(set.channels));
-  put<std::uint32_t>(h, kOffColumns, std::uint32_t(set.columns));
-  put<std::uint32_t>(h, kOffClusterCount, std::uint32_t(set.cluster_count));
-  put<std::uint32_t>(h, kOffComponentCount, std::uint32_t(set.component_count));
-  put<std::uint32_t>(h, kOffMethod, static_cast<std::uint32_t>(set.method));
-  put<std::uint32_t>(h, kOffSolver, static_cast<std::uint32_t>(set.solver));
-  put<std::uint32_t>(h, kOffOverdraw, set.overdraw_reduction ? 1u : 0u);
-  put<std::uint32_t>(h, kOffIterations, std::uint32_t(set.iterations));
-  put<std::uint32_t>(h, kOffMeshPathBytes, std::uint32_t(set.mesh_path.size()));
-  put<std::uint64_t>(h, kOffVertexCount, set.vertex_count);
-  put<std::uint64_t>(h, kOffSeed, set.seed);
-  put<std::uint64_t>(h, kOffMeshHash, set.mesh_hash);
-  put<std::uint64_t>(h, kOffTransferHash, set.transfer_hash);
-  put<double>(h, kOffAlpha, set.alpha);
-  put<std::uint64_t>(h, kOffPayloadBytes, sizes.payload_bytes);
-  put<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum_of(set));
-  put<std::uint64_t>(h, kOffMeshPathChecksum,
-                     common::fnv1a(set.mesh_path.data(), set.mesh_path.size()));
-  put<std::uint64_t>(h, kOffHeaderChecksum, common::fnv1a(h.data(), kOffHeaderChecksum));
+  common::put_field<std::uint32_t>(h, kOffVersion, kCompressedFileVersion);
+  common::put_field<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
+  common::put_field<std::uint32_t>(h, kOffOrder, std::uint32_t(set.order));
+  common::put_field<std::uint32_t>(h, kOffChannels, std::uint32_t(set.channels));
+  common::put_field<std::uint32_t>(h, kOffColumns, std::uint32_t(set.columns));
+  common::put_field<std::uint32_t>(h, kOffClusterCount, std::uint32_t(set.cluster_count));
+  common::put_field<std::uint32_t>(h, kOffComponentCount, std::uint32_t(set.component_count));
+  common::put_field<std::uint32_t>(h, kOffMethod, static_cast<std::uint32_t>(set.method));
+  common::put_field<std::uint32_t>(h, kOffSolver, static_cast<std::uint32_t>(set.solver));
+  common::put_field<std::uint32_t>(h, kOffOverdraw, set.overdraw_reduction ? 1u : 0u);
+  common::put_field<std::uint32_t>(h, kOffIterations, std::uint32_t(set.iterations));
+  common::put_field<std::uint32_t>(h, kOffMeshPathBytes, std::uint32_t(set.mesh_path.size()));
+  common::put_field<std::uint64_t>(h, kOffVertexCount, set.vertex_count);
+  common::put_field<std::uint64_t>(h, kOffSeed, set.seed);
+  common::put_field<std::uint64_t>(h, kOffMeshHash, set.mesh_hash);
+  common::put_field<std::uint64_t>(h, kOffTransferHash, set.transfer_hash);
+  common::put_field<double>(h, kOffAlpha, set.alpha);
+  common::put_field<std::uint64_t>(h, kOffPayloadBytes, sizes.payload_bytes);
+  common::put_field<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum_of(set));
+  common::put_field<std::uint64_t>(h, kOffMeshPathChecksum,
+                                   common::fnv1a(set.mesh_path.data(), set.mesh_path.size()));
+  common::put_field<std::uint64_t>(h, kOffHeaderChecksum,
+                                   common::fnv1a(h.data(), kOffHeaderChecksum));
   return h;
-}
-
-std::string printable(const char* bytes, std::size_t n) {
-  std::string s;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(bytes[i]);
-    if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
-      s += static_cast<char>(c);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      s += buf;
-    }
-  }
-  return s;
 }
 
 CompressedSet read(const fs::path& path, bool with_payload) {
@@ -322,26 +290,12 @@ CompressedSet read(const fs::path& path, bool with_payload) {
     return CompressedFileError(name + ": " + problem);
   };
 
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw fail("cannot be inspected (" + ec.message() + "); check the path and permissions");
-  }
-  if (!fs::exists(status)) {
-    throw fail("no such compressed file; check the path, or create it with prtr compress");
-  }
-  if (fs::is_directory(status)) {
-    throw fail(
-        "is a directory, not a compressed file; name the .prtc file written by "
-        "prtr compress");
-  }
-  if (!fs::is_regular_file(status)) {
-    throw fail("is not a regular file; name the .prtc file written by prtr compress");
-  }
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fail("cannot be opened for reading; check its permissions");
+  common::OpenedFile opened =
+      common::open_binary(path, "compressed file", "the .prtc file written by prtr compress",
+                          "create it with prtr compress");
+  if (!opened.problem.empty()) throw fail(opened.problem);
+  std::ifstream& in = opened.stream;
+  const std::uintmax_t size = opened.size;
 
   const auto truncated_header = [&](std::uintmax_t found) {
     return fail("truncated header: the file has " + std::to_string(found) +
@@ -355,10 +309,10 @@ CompressedSet read(const fs::path& path, bool with_payload) {
 
   if (std::memcmp(h.data() + kOffMagic, kMagic.data(), kMagic.size()) != 0) {
     throw fail("not a prtr compressed file (it starts with \"" +
-               printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
+               common::printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
                "\", not \"PRTRCMPR\"); name a .prtc file written by prtr compress");
   }
-  const auto version = get<std::uint32_t>(h, kOffVersion);
+  const auto version = common::get_field<std::uint32_t>(h, kOffVersion);
   if (version != kCompressedFileVersion) {
     const bool newer = version > kCompressedFileVersion;
     throw fail(std::string("written by ") + (newer ? "a newer" : "an older") +
@@ -366,31 +320,31 @@ CompressedSet read(const fs::path& path, bool with_payload) {
                "; this prtr reads version " + std::to_string(kCompressedFileVersion) + "); " +
                (newer ? "use that prtr, or " : "") + kRecompress + " from this version");
   }
-  const auto header_bytes = get<std::uint32_t>(h, kOffHeaderBytes);
+  const auto header_bytes = common::get_field<std::uint32_t>(h, kOffHeaderBytes);
   if (header_bytes != kHeaderBytes) {
     throw fail("header size " + std::to_string(header_bytes) + " bytes, version 1 has " +
                std::to_string(kHeaderBytes) + "; the header is damaged: " + kRecompress);
   }
 
   Fields f;
-  f.order = get<std::uint32_t>(h, kOffOrder);
-  f.channels = get<std::uint32_t>(h, kOffChannels);
-  f.columns = get<std::uint32_t>(h, kOffColumns);
-  f.clusters = get<std::uint32_t>(h, kOffClusterCount);
-  f.components = get<std::uint32_t>(h, kOffComponentCount);
-  f.method = get<std::uint32_t>(h, kOffMethod);
-  f.solver = get<std::uint32_t>(h, kOffSolver);
-  f.overdraw = get<std::uint32_t>(h, kOffOverdraw);
-  f.iterations = get<std::uint32_t>(h, kOffIterations);
-  f.mesh_path_bytes = get<std::uint32_t>(h, kOffMeshPathBytes);
-  f.vertex_count = get<std::uint64_t>(h, kOffVertexCount);
-  f.alpha = get<double>(h, kOffAlpha);
+  f.order = common::get_field<std::uint32_t>(h, kOffOrder);
+  f.channels = common::get_field<std::uint32_t>(h, kOffChannels);
+  f.columns = common::get_field<std::uint32_t>(h, kOffColumns);
+  f.clusters = common::get_field<std::uint32_t>(h, kOffClusterCount);
+  f.components = common::get_field<std::uint32_t>(h, kOffComponentCount);
+  f.method = common::get_field<std::uint32_t>(h, kOffMethod);
+  f.solver = common::get_field<std::uint32_t>(h, kOffSolver);
+  f.overdraw = common::get_field<std::uint32_t>(h, kOffOverdraw);
+  f.iterations = common::get_field<std::uint32_t>(h, kOffIterations);
+  f.mesh_path_bytes = common::get_field<std::uint32_t>(h, kOffMeshPathBytes);
+  f.vertex_count = common::get_field<std::uint64_t>(h, kOffVertexCount);
+  f.alpha = common::get_field<double>(h, kOffAlpha);
   if (const std::string problem = field_problem(f); !problem.empty()) {
     throw fail(problem + " in the header; the file is damaged: " + kRecompress);
   }
 
   Sizes sizes;
-  const std::uint64_t payload_bytes = get<std::uint64_t>(h, kOffPayloadBytes);
+  const std::uint64_t payload_bytes = common::get_field<std::uint64_t>(h, kOffPayloadBytes);
   if (!sizes_of(f, &sizes) || payload_bytes != sizes.payload_bytes) {
     throw fail("payload size mismatch: the header says " + std::to_string(payload_bytes) +
                " bytes, but " + std::to_string(f.vertex_count) + " vertices, " +
@@ -399,9 +353,11 @@ CompressedSet read(const fs::path& path, bool with_payload) {
                "; the header is damaged: " + kRecompress);
   }
   const auto header_checksum = common::fnv1a(h.data(), kOffHeaderChecksum);
-  if (header_checksum != get<std::uint64_t>(h, kOffHeaderChecksum)) {
-    throw fail("header damaged (checksum " + hex(header_checksum) + ", the header records " +
-               hex(get<std::uint64_t>(h, kOffHeaderChecksum)) + "); " + kRecompress);
+  if (header_checksum != common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) {
+    throw fail("header damaged (checksum " + common::hex64(header_checksum) +
+               ", the header records " +
+               common::hex64(common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) + "); " +
+               kRecompress);
   }
   const std::size_t path_block = padded(f.mesh_path_bytes);
   std::uint64_t expected_size = 0;
@@ -434,9 +390,9 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   set.overdraw_reduction = f.overdraw != 0;
   set.iterations = int(f.iterations);
   set.alpha = f.alpha;
-  set.seed = get<std::uint64_t>(h, kOffSeed);
-  set.mesh_hash = get<std::uint64_t>(h, kOffMeshHash);
-  set.transfer_hash = get<std::uint64_t>(h, kOffTransferHash);
+  set.seed = common::get_field<std::uint64_t>(h, kOffSeed);
+  set.mesh_hash = common::get_field<std::uint64_t>(h, kOffMeshHash);
+  set.transfer_hash = common::get_field<std::uint64_t>(h, kOffTransferHash);
 
   // The file size was checked, so a short read below means the file changed under us.
   std::size_t offset = kHeaderBytes;
@@ -449,9 +405,11 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   read_into(block.data(), path_block);
   set.mesh_path = block.substr(0, f.mesh_path_bytes);
   const auto path_checksum = common::fnv1a(set.mesh_path.data(), set.mesh_path.size());
-  if (path_checksum != get<std::uint64_t>(h, kOffMeshPathChecksum)) {
-    throw fail("mesh path damaged (checksum " + hex(path_checksum) + ", the header records " +
-               hex(get<std::uint64_t>(h, kOffMeshPathChecksum)) + "); " + kRecompress);
+  if (path_checksum != common::get_field<std::uint64_t>(h, kOffMeshPathChecksum)) {
+    throw fail("mesh path damaged (checksum " + common::hex64(path_checksum) +
+               ", the header records " +
+               common::hex64(common::get_field<std::uint64_t>(h, kOffMeshPathChecksum)) + "); " +
+               kRecompress);
   }
   if (const std::size_t i = first_bad_utf8(set.mesh_path); i != set.mesh_path.size()) {
     throw fail("mesh path is not UTF-8 (byte " + std::to_string(i) +
@@ -471,9 +429,11 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   read_into(set.means.data(), sizes.means * 4);
   read_into(set.bases.data(), sizes.bases * 4);
   const auto payload_checksum = payload_checksum_of(set);
-  if (payload_checksum != get<std::uint64_t>(h, kOffPayloadChecksum)) {
-    throw fail("payload damaged (checksum " + hex(payload_checksum) + ", the header records " +
-               hex(get<std::uint64_t>(h, kOffPayloadChecksum)) + "); " + kRecompress);
+  if (payload_checksum != common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) {
+    throw fail("payload damaged (checksum " + common::hex64(payload_checksum) +
+               ", the header records " +
+               common::hex64(common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) + "); " +
+               kRecompress);
   }
   if (const std::string problem = value_problem(set); !problem.empty()) {
     throw fail(problem + "; the file is damaged: " + kRecompress);
@@ -491,7 +451,7 @@ void write_compressed(const fs::path& path, const CompressedSet& set) {
   const Fields f = fields_of(set);
   if (const std::string problem = field_problem(f); !problem.empty()) throw refuse(problem);
   if (const std::size_t i = first_bad_utf8(set.mesh_path); i != set.mesh_path.size()) {
-    throw refuse("mesh path \"" + printable(set.mesh_path.data(), set.mesh_path.size()) +
+    throw refuse("mesh path \"" + common::printable(set.mesh_path.data(), set.mesh_path.size()) +
                  "\" is not UTF-8 without NUL (byte " + std::to_string(i) + ")");
   }
   try {

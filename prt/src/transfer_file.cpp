@@ -9,6 +9,7 @@
 #include "prt/transfer_file.h"
 
 #include "common/atomic_file.h"
+#include "common/binary_file.h"
 #include "common/hash.h"
 
 #include <array>
@@ -71,25 +72,6 @@ constexpr float kMaxExponent = 10000.f;
 constexpr const char* kRebake = "bake it again with prtr bake";
 
 using Header = std::array<unsigned char, kHeaderBytes>;
-
-template <class T>
-void put(Header& h, std::size_t offset, T value) {
-  static_assert(std::is_trivially_copyable_v<T>);
-  std::memcpy(h.data() + offset, &value, sizeof(T));
-}
-
-template <class T>
-T get(const Header& h, std::size_t offset) {
-  T value;
-  std::memcpy(&value, h.data() + offset, sizeof(T));
-  return value;
-}
-
-std::string hex(std::uint64_t v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
-  return buf;
-}
 
 std::string num(float v) {
   char buf[48];
@@ -196,41 +178,29 @@ std::size_t first_non_finite(const std::vector<float>& data) {
 Header encode_header(const TransferSet& set, std::uint64_t payload_checksum) {
   Header h{};  // zero: padding and reserved fields
   std::memcpy(h.data() + kOffMagic, kMagic.data(), kMagic.size());
-  put<std::uint32_t>(h, kOffVersion, kTransferFileVersion);
-  put<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
-  put<std::uint32_t>(h, kOffKind, static_cast<std::uint32_t>(set.kind));
-  put<std::uint32_t>(h, kOffOrder, static_cast<std::uint32_t>(set.order));
-  put<std::uint32_t>(h, kOffChannels, static_cast<std::uint32_t>(set.channels));
-  put<std::uint32_t>(h, kOffSamples, static_cast<std::uint32_t>(set.samples));
-  put<std::uint32_t>(h, kOffBounces, static_cast<std::uint32_t>(set.bounces));
-  put<std::uint32_t>(h, kOffMaterialKind, static_cast<std::uint32_t>(set.material.kind));
-  put<std::uint64_t>(h, kOffVertexCount, set.vertex_count);
-  put<std::uint64_t>(h, kOffSeed, set.seed);
-  put<std::uint64_t>(h, kOffMeshHash, set.mesh_hash);
-  for (int c = 0; c < 3; ++c) put<float>(h, kOffAlbedo + 4 * c, set.material.albedo[c]);
-  put<float>(h, kOffSpecular, set.material.specular);
-  put<float>(h, kOffExponent, set.material.exponent);
-  put<float>(h, kOffRoughness, set.material.roughness);
-  put<float>(h, kOffF0, set.material.f0);
-  put<std::uint64_t>(h, kOffPayloadFloats, set.data.size());
-  put<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum);
-  put<std::uint64_t>(h, kOffHeaderChecksum, common::fnv1a(h.data(), kOffHeaderChecksum));
+  common::put_field<std::uint32_t>(h, kOffVersion, kTransferFileVersion);
+  common::put_field<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
+  common::put_field<std::uint32_t>(h, kOffKind, static_cast<std::uint32_t>(set.kind));
+  common::put_field<std::uint32_t>(h, kOffOrder, static_cast<std::uint32_t>(set.order));
+  common::put_field<std::uint32_t>(h, kOffChannels, static_cast<std::uint32_t>(set.channels));
+  common::put_field<std::uint32_t>(h, kOffSamples, static_cast<std::uint32_t>(set.samples));
+  common::put_field<std::uint32_t>(h, kOffBounces, static_cast<std::uint32_t>(set.bounces));
+  common::put_field<std::uint32_t>(h, kOffMaterialKind,
+                                   static_cast<std::uint32_t>(set.material.kind));
+  common::put_field<std::uint64_t>(h, kOffVertexCount, set.vertex_count);
+  common::put_field<std::uint64_t>(h, kOffSeed, set.seed);
+  common::put_field<std::uint64_t>(h, kOffMeshHash, set.mesh_hash);
+  for (int c = 0; c < 3; ++c)
+    common::put_field<float>(h, kOffAlbedo + 4 * c, set.material.albedo[c]);
+  common::put_field<float>(h, kOffSpecular, set.material.specular);
+  common::put_field<float>(h, kOffExponent, set.material.exponent);
+  common::put_field<float>(h, kOffRoughness, set.material.roughness);
+  common::put_field<float>(h, kOffF0, set.material.f0);
+  common::put_field<std::uint64_t>(h, kOffPayloadFloats, set.data.size());
+  common::put_field<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum);
+  common::put_field<std::uint64_t>(h, kOffHeaderChecksum,
+                                   common::fnv1a(h.data(), kOffHeaderChecksum));
   return h;
-}
-
-std::string printable(const char* bytes, std::size_t n) {
-  std::string s;
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(bytes[i]);
-    if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
-      s += static_cast<char>(c);
-    } else {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      s += buf;
-    }
-  }
-  return s;
 }
 
 TransferSet read(const fs::path& path, bool with_payload) {
@@ -239,25 +209,11 @@ TransferSet read(const fs::path& path, bool with_payload) {
     return TransferFileError(name + ": " + problem);
   };
 
-  // File-system problems first, each with its own fix.
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw fail("cannot be inspected (" + ec.message() + "); check the path and permissions");
-  }
-  if (!fs::exists(status)) {
-    throw fail("no such transfer file; check the path, or create it with prtr bake");
-  }
-  if (fs::is_directory(status)) {
-    throw fail("is a directory, not a transfer file; name the .prtx file written by prtr bake");
-  }
-  if (!fs::is_regular_file(status)) {
-    throw fail("is not a regular file; name the .prtx file written by prtr bake");
-  }
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fail("cannot be opened for reading; check its permissions");
+  common::OpenedFile opened = common::open_binary(
+      path, "transfer file", "the .prtx file written by prtr bake", "create it with prtr bake");
+  if (!opened.problem.empty()) throw fail(opened.problem);
+  std::ifstream& in = opened.stream;
+  const std::uintmax_t size = opened.size;
 
   const auto truncated_header = [&](std::uintmax_t found) {
     return fail("truncated header: the file has " + std::to_string(found) +
@@ -272,10 +228,10 @@ TransferSet read(const fs::path& path, bool with_payload) {
   // Identity and version before any field is trusted.
   if (std::memcmp(h.data() + kOffMagic, kMagic.data(), kMagic.size()) != 0) {
     throw fail("not a prtr transfer file (it starts with \"" +
-               printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
+               common::printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
                "\", not \"PRTRXFER\"); name a .prtx file written by prtr bake");
   }
-  const auto version = get<std::uint32_t>(h, kOffVersion);
+  const auto version = common::get_field<std::uint32_t>(h, kOffVersion);
   if (version != kTransferFileVersion) {
     const std::string which = version > kTransferFileVersion ? "a newer" : "an older";
     throw fail("written by " + which + " prtr version (file format version " +
@@ -284,29 +240,30 @@ TransferSet read(const fs::path& path, bool with_payload) {
                (version > kTransferFileVersion ? "use that prtr, or " : "") + kRebake +
                " from this version");
   }
-  const auto header_bytes = get<std::uint32_t>(h, kOffHeaderBytes);
+  const auto header_bytes = common::get_field<std::uint32_t>(h, kOffHeaderBytes);
   if (header_bytes != kHeaderBytes) {
     throw fail("header size " + std::to_string(header_bytes) + " bytes, version 1 has " +
                std::to_string(kHeaderBytes) + "; the header is damaged: " + kRebake);
   }
 
   Fields f;
-  f.kind = get<std::uint32_t>(h, kOffKind);
-  f.order = get<std::uint32_t>(h, kOffOrder);
-  f.channels = get<std::uint32_t>(h, kOffChannels);
-  f.samples = get<std::uint32_t>(h, kOffSamples);
-  f.bounces = get<std::uint32_t>(h, kOffBounces);
-  f.material_kind = get<std::uint32_t>(h, kOffMaterialKind);
-  f.vertex_count = get<std::uint64_t>(h, kOffVertexCount);
-  for (int c = 0; c < 3; ++c) f.albedo[c] = get<float>(h, kOffAlbedo + 4 * c);
-  f.specular = get<float>(h, kOffSpecular);
-  f.exponent = get<float>(h, kOffExponent);
-  f.roughness = get<float>(h, kOffRoughness);
-  f.f0 = get<float>(h, kOffF0);
+  f.kind = common::get_field<std::uint32_t>(h, kOffKind);
+  f.order = common::get_field<std::uint32_t>(h, kOffOrder);
+  f.channels = common::get_field<std::uint32_t>(h, kOffChannels);
+  f.samples = common::get_field<std::uint32_t>(h, kOffSamples);
+  f.bounces = common::get_field<std::uint32_t>(h, kOffBounces);
+  f.material_kind = common::get_field<std::uint32_t>(h, kOffMaterialKind);
+  f.vertex_count = common::get_field<std::uint64_t>(h, kOffVertexCount);
+  for (int c = 0; c < 3; ++c) f.albedo[c] = common::get_field<float>(h, kOffAlbedo + 4 * c);
+  f.specular = common::get_field<float>(h, kOffSpecular);
+  f.exponent = common::get_field<float>(h, kOffExponent);
+  f.roughness = common::get_field<float>(h, kOffRoughness);
+  f.f0 = common::get_field<float>(h, kOffF0);
   if (const std::string problem = field_problem(f); !problem.empty()) {
     throw fail(problem + " in the header; the file is damaged: " + kRebake);
   }
-  if (get<std::uint32_t>(h, kOffReserved0) != 0 || get<std::uint64_t>(h, kOffReserved1) != 0) {
+  if (common::get_field<std::uint32_t>(h, kOffReserved0) != 0 ||
+      common::get_field<std::uint64_t>(h, kOffReserved1) != 0) {
     throw fail("reserved header bytes are not zero; the file is damaged: " + std::string(kRebake));
   }
 
@@ -317,9 +274,9 @@ TransferSet read(const fs::path& path, bool with_payload) {
   set.samples = static_cast<int>(f.samples);
   set.bounces = static_cast<int>(f.bounces);
   set.vertex_count = f.vertex_count;
-  set.seed = get<std::uint64_t>(h, kOffSeed);
-  set.mesh_hash = get<std::uint64_t>(h, kOffMeshHash);
-  set.payload_checksum = get<std::uint64_t>(h, kOffPayloadChecksum);
+  set.seed = common::get_field<std::uint64_t>(h, kOffSeed);
+  set.mesh_hash = common::get_field<std::uint64_t>(h, kOffMeshHash);
+  set.payload_checksum = common::get_field<std::uint64_t>(h, kOffPayloadChecksum);
   set.material.kind = static_cast<MaterialKind>(f.material_kind);
   set.material.albedo = Eigen::Vector3f(f.albedo[0], f.albedo[1], f.albedo[2]);
   set.material.specular = f.specular;
@@ -329,7 +286,7 @@ TransferSet read(const fs::path& path, bool with_payload) {
 
   // Sizes: vertex_count <= 2^40 and floats_per_vertex <= 3 * 100 * 100, so the product fits
   // in 64 bits; the checks stay in case either limit grows.
-  const std::uint64_t payload_floats = get<std::uint64_t>(h, kOffPayloadFloats);
+  const std::uint64_t payload_floats = common::get_field<std::uint64_t>(h, kOffPayloadFloats);
   std::uint64_t expected_floats = 0;
   if (!payload_floats_of(set.vertex_count, set.floats_per_vertex(), &expected_floats) ||
       payload_floats != expected_floats) {
@@ -339,9 +296,10 @@ TransferSet read(const fs::path& path, bool with_payload) {
                std::to_string(expected_floats) + "; the header is damaged: " + kRebake);
   }
   const auto header_checksum = common::fnv1a(h.data(), kOffHeaderChecksum);
-  if (header_checksum != get<std::uint64_t>(h, kOffHeaderChecksum)) {
-    throw fail("header damaged (checksum " + hex(header_checksum) + ", the header records " +
-               hex(get<std::uint64_t>(h, kOffHeaderChecksum)) + "); " + kRebake);
+  if (header_checksum != common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) {
+    throw fail(
+        "header damaged (checksum " + common::hex64(header_checksum) + ", the header records " +
+        common::hex64(common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) + "); " + kRebake);
   }
   std::uint64_t expected_size = 0;
   if (__builtin_mul_overflow(payload_floats, std::uint64_t(4), &expected_size) ||
@@ -371,9 +329,10 @@ TransferSet read(const fs::path& path, bool with_payload) {
     throw size_problem(kHeaderBytes + std::size_t(in.gcount()));
   }
   const auto payload_checksum = common::fnv1a(set.data.data(), payload_bytes);
-  if (payload_checksum != get<std::uint64_t>(h, kOffPayloadChecksum)) {
-    throw fail("payload damaged (checksum " + hex(payload_checksum) + ", the header records " +
-               hex(get<std::uint64_t>(h, kOffPayloadChecksum)) + "); " + kRebake);
+  if (payload_checksum != common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) {
+    throw fail(
+        "payload damaged (checksum " + common::hex64(payload_checksum) + ", the header records " +
+        common::hex64(common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) + "); " + kRebake);
   }
   if (const std::size_t i = first_non_finite(set.data); i != set.data.size()) {
     throw fail("non-finite value " + num(set.data[i]) + " at " + locate(set, i) +
