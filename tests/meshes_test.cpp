@@ -873,3 +873,60 @@ TEST(LoadErrors, NonFiniteCoordinates) {
 }
 
 }  // namespace
+
+// --- 3DS ---------------------------------------------------------------------------------------
+
+namespace {
+
+// A chunk: id, total length (header included), body.
+std::string chunk(std::uint16_t id, const std::string& body) {
+  std::string s(6, '\0');
+  const std::uint32_t length = std::uint32_t(6 + body.size());
+  std::memcpy(s.data(), &id, 2);
+  std::memcpy(s.data() + 2, &length, 4);
+  return s + body;
+}
+
+template <class T>
+std::string bytes_of(const T& value) {
+  return std::string(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+// One object with a quad as two triangles, 3DS Z-up coordinates.
+std::string quad_3ds() {
+  std::string vertices = bytes_of(std::uint16_t(4));
+  const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (const auto& v : p) vertices += std::string(reinterpret_cast<const char*>(v), 12);
+  std::string faces = bytes_of(std::uint16_t(2));
+  const std::uint16_t f[2][4] = {{0, 1, 2, 7}, {0, 2, 3, 7}};
+  for (const auto& t : f) faces += std::string(reinterpret_cast<const char*>(t), 8);
+  const std::string mesh = chunk(0x4100, chunk(0x4110, vertices) + chunk(0x4120, faces));
+  return chunk(0x4D4D, chunk(0x3D3D, chunk(0x4000, std::string("quad") + '\0' + mesh)));
+}
+
+}  // namespace
+
+TEST(Load, ThreeDsGeometryIsConvertedToYUp) {
+  const Mesh m = meshes::load_mesh(write_file("quad.3ds", quad_3ds()));
+  ASSERT_EQ(m.vertex_count(), 4u);
+  ASSERT_EQ(m.triangle_count(), 2u);
+  // 3DS (x, y, z) -> (x, z, -y): the quad in the 3DS ground plane lies in our XZ plane, and
+  // its counter-clockwise winding about 3DS +Z now faces our +Y.
+  for (const Vec3& p : m.positions) EXPECT_FLOAT_EQ(p.y(), 0.f);
+  for (const Triangle& t : m.triangles) EXPECT_GT(face_normal(m, t).normalized().y(), 0.999f);
+}
+
+TEST(LoadErrors, DamagedThreeDsChunks) {
+  std::string truncated = quad_3ds();
+  truncated.resize(truncated.size() - 10);  // the face list claims more than is there
+  expect_load_error(write_file("truncated.3ds", truncated), "damaged");
+  expect_load_error(write_file("notthreeds.3ds", "hello, not a 3ds file"), "not a 3DS file");
+}
+
+TEST(Load, GlmarkHorse) {
+  const fs::path horse = "/usr/share/glmark2/models/horse.3ds";
+  if (!fs::exists(horse)) GTEST_SKIP() << horse << " not installed (package glmark2-data)";
+  const Mesh m = meshes::load_mesh(horse);
+  EXPECT_EQ(m.vertex_count(), 3582u);
+  EXPECT_EQ(m.triangle_count(), 7172u);
+}

@@ -1,5 +1,5 @@
-// meshes/load.cpp: OBJ/PLY/OFF/STL through OpenMesh's IO layer, then clean-up (weld, drop
-// degenerate and unreferenced, frames).
+// meshes/load.cpp: OBJ/PLY/OFF/STL through OpenMesh's IO layer, 3DS through our own reader,
+// then clean-up (weld, drop degenerate and unreferenced, frames).
 //
 // OpenMesh is used only for parsing. Its readers feed a BaseImporter; OpenMesh's own
 // ImporterT builds a halfedge mesh, which cannot hold non-manifold ("complex") faces: it
@@ -14,6 +14,8 @@
 // 27 cells around it. Vertices are visited in index order and each merges into the lowest
 // index within reach, so the result does not depend on hash-table order.
 #include "meshes/load.h"
+
+#include "read_3ds.h"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
@@ -44,7 +46,7 @@ constexpr double kDegenerateAreaRatio = 1e-12;
 // of the size of the mesh, and grid cell coordinates could overflow; weld exact matches only.
 constexpr double kSmallestGridTolerance = 1e-15;
 
-constexpr std::array<const char*, 4> kFormats = {"obj", "ply", "off", "stl"};
+constexpr std::array<const char*, 5> kFormats = {"obj", "ply", "off", "stl", "3ds"};
 
 std::string supported_list() {
   std::string out;
@@ -416,7 +418,25 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
   {
     const std::lock_guard<std::mutex> lock(reader_mutex());
     omio::Options opt;
-    if (format == "stl") {
+    if (format == "3ds") {
+      detail::Raw3ds raw;
+      const std::string problem = detail::read_3ds(path, raw);
+      if (!problem.empty()) throw fail(problem);
+      for (const Vec3& p : raw.positions) importer.positions.push_back(p);
+      for (std::size_t c = 0; c < raw.corners.size(); c += 3) {
+        for (std::size_t k = 0; k < 3; ++k) {
+          const std::uint32_t index = raw.corners[c + k];
+          if (index >= importer.positions.size() && !importer.has_bad_face) {
+            importer.has_bad_face = true;
+            importer.bad_face = importer.face_count();
+            importer.bad_index = index;
+          }
+          importer.corners.push_back(index < importer.positions.size() ? index : 0);
+        }
+        importer.face_offsets.push_back(importer.corners.size());
+      }
+      parsed = true;
+    } else if (format == "stl") {
       // Through the stream interface, so the binary/ASCII decision is ours.
       const bool binary = is_binary_stl(path, size);
       std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
