@@ -10,15 +10,14 @@
 // and frames for every row, and measures the image RMSE against the uncompressed render.
 // Single-pass and decoupled FPS per K show what the overdraw costs.
 //
-// Caching (stated in the output): the bake is cached in --cache keyed by the mesh content
-// hash and every bake parameter; compressed sets too, keyed by the bake's payload checksum
-// and every compression parameter, with the clustering time measured when they were made.
+// Caching (stated in the output): bakes and compressed sets go through the shared cache of
+// apps/prtr/pipeline.h (keyed by content and every parameter), which also keeps each
+// compression's clustering time and errors, so a cached row reports what was measured.
 #include "bake_flags.h"
 #include "commands.h"
 #include "pipeline.h"
 
 #include "common/atomic_file.h"
-#include "common/hash.h"
 #include "cpca/compress.h"
 #include "cpca/compressed_file.h"
 #include "cpca/supercluster.h"
@@ -41,7 +40,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -106,35 +104,6 @@ const MethodPreset& find_method(const std::string& name) {
   std::string names;
   for (const MethodPreset& m : kMethods) names += std::string(names.empty() ? "" : ", ") + m.name;
   throw UsageError("--rows: unknown method '" + name + "'; use one of " + names);
-}
-
-std::string hex16(std::uint64_t v) {
-  char b[17];
-  std::snprintf(b, sizeof b, "%016llx", (unsigned long long)v);
-  return b;
-}
-
-template <class T>
-std::uint64_t mix(std::uint64_t h, const T& value) {
-  return common::fnv1a(&value, sizeof value, h);
-}
-
-std::uint64_t compress_key(std::uint64_t transfer_hash, const cpca::CompressOptions& c) {
-  std::uint64_t h = mix(common::kFnvOffset, transfer_hash);
-  h = mix(h, c.clusters);
-  h = mix(h, c.components);
-  h = mix(h, int(c.method));
-  h = mix(h, int(c.solver));
-  h = mix(h, c.alpha);
-  h = mix(h, c.overdraw_reduction);
-  h = mix(h, c.overdraw.tolerance);
-  h = mix(h, c.overdraw.max_sweeps);
-  h = mix(h, c.seed);
-  h = mix(h, c.lbg_threshold);
-  h = mix(h, c.lbg_max_iterations);
-  h = mix(h, c.cpca_threshold);
-  h = mix(h, c.cpca_max_iterations);
-  return h;
 }
 
 // RMSE over pixels both images cover (alpha > 0.5), averaged over R, G, B, and the
@@ -361,9 +330,6 @@ Runner add_overdraw_command(CLI::App& app) {
     }
 
     const cpca::Geometry geometry = geometry_of(mesh);
-    const Eigen::Map<const cpca::DataMatrix> data(transfer.data.data(),
-                                                  Eigen::Index(transfer.vertex_count),
-                                                  Eigen::Index(transfer.floats_per_vertex()));
     fs::create_directories(o.out);
     fs::create_directories(o.cache);
 
@@ -384,40 +350,14 @@ Runner add_overdraw_command(CLI::App& app) {
         co.overdraw_reduction = method->overdraw_reduction;
         co.overdraw.tolerance = o.tolerance;
         const std::string label = "K=" + std::to_string(k) + " " + method->name;
-        const fs::path cached =
-            fs::path(o.cache) / (fs::path(o.mesh).stem().string() + "-" +
-                                 hex16(compress_key(transfer.payload_checksum, co)) + ".prtc");
-        const fs::path sidecar = fs::path(cached).replace_extension(".times");
-        cpca::CompressedSet set;
-        double clustering_seconds = 0, average_se = 0, relative_error = 0;
-        bool reused = false;
-        if (!o.recompress && fs::exists(cached) && fs::exists(sidecar)) {
-          std::ifstream in(sidecar);
-          if (in >> clustering_seconds >> average_se >> relative_error) {
-            set = cpca::read_compressed(cached);
-            reused = set.transfer_hash == transfer.payload_checksum;
-          }
-        }
-        if (reused) {
-          report.compressions_cached = true;
-          bar.update(label + ": cached compression", step, steps);
-        } else {
-          cpca::CompressReport cr;
-          set = cpca::compress(data, co, &geometry, &cr, [&](const std::string& stage, double) {
-            bar.update(label + ": " + stage, step, steps);
-          });
-          set.mesh_hash = transfer.mesh_hash;
-          set.transfer_hash = transfer.payload_checksum;
-          set.mesh_path = fs::absolute(o.mesh).lexically_normal().string();
-          clustering_seconds = cr.clustering_seconds();
-          average_se = cr.error.average_squared_error;
-          relative_error = cr.error.relative_error;
-          cpca::write_compressed(cached, set);
-          char times[128];
-          std::snprintf(times, sizeof times, "%.9g %.9g %.9g\n", clustering_seconds, average_se,
-                        relative_error);
-          write_text(sidecar, times);
-        }
+        bar.update(label + ": compression", step, steps);
+        const CompressCacheResult compressed =
+            cached_compress(report.transfer, mesh, o.mesh, co, o.cache, true, o.recompress);
+        if (compressed.hit) report.compressions_cached = true;
+        const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
+        const double clustering_seconds = compressed.summary.clustering_seconds;
+        const double average_se = compressed.summary.average_se;
+        const double relative_error = compressed.summary.relative_error;
         ++step;
         const cpca::TriangleSpan span = cpca::triangle_span(set.cluster_of, geometry.triangles);
 

@@ -171,7 +171,7 @@ Runner add_relight_command(CLI::App& app) {
     const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
     const double bake_s = std::chrono::duration<double>(Clock::now() - t_bake).count();
     const auto t_compress = Clock::now();
-    const CacheResult compressed =
+    const CompressCacheResult compressed =
         cached_compress(transfer.path, mesh, o.mesh, o.compress, cache, o.quiet);
     const double compress_s = std::chrono::duration<double>(Clock::now() - t_compress).count();
     std::printf("bake        %s %s (%.1f s)\n", transfer.hit ? "cached" : "baked",

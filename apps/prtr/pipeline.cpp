@@ -1,5 +1,6 @@
 #include "pipeline.h"
 
+#include "common/atomic_file.h"
 #include "common/hash.h"
 #include "cpca/compressed_file.h"
 #include "progress_bar.h"
@@ -7,6 +8,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
@@ -145,9 +147,9 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
   return r;
 }
 
-CacheResult cached_compress(const fs::path& transfer_path, const meshes::Mesh& mesh,
-                            const std::string& mesh_path, const cpca::CompressOptions& o,
-                            const fs::path& cache_dir, bool quiet) {
+CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes::Mesh& mesh,
+                                    const std::string& mesh_path, const cpca::CompressOptions& o,
+                                    const fs::path& cache_dir, bool quiet, bool rebuild) {
   const prt::TransferSet header = prt::read_transfer_header(transfer_path);
   std::ostringstream key;
   key.precision(9);
@@ -158,12 +160,20 @@ CacheResult cached_compress(const fs::path& transfer_path, const meshes::Mesh& m
       << ' ' << o.overdraw.max_sweeps << " seed " << o.seed << " lbg " << o.lbg_threshold << ' '
       << o.lbg_max_iterations << " cpca " << o.cpca_threshold << ' ' << o.cpca_max_iterations << ' '
       << o.cpca_candidates;
-  CacheResult r{cache_dir / ("cpca-" + hex(hash_text(key.str())) + ".prtc"), false};
-  if (fs::exists(r.path)) {
+  const std::string stem = "cpca-" + hex(hash_text(key.str()));
+  CompressCacheResult r;
+  r.path = cache_dir / (stem + ".prtc");
+  // The compression's own measurements, which a cached set cannot reproduce.
+  const fs::path summary = cache_dir / (stem + ".summary");
+  if (!rebuild && fs::exists(r.path)) {
     try {
       const cpca::CompressedSet set = cpca::read_compressed_header(r.path);
       if (set.transfer_hash != header.payload_checksum)
         throw std::runtime_error("compressed from another bake");
+      std::ifstream in(summary);
+      CompressionSummary& m = r.summary;
+      if (!(in >> m.clustering_seconds >> m.average_se >> m.relative_error))
+        throw std::runtime_error("its summary " + summary.string() + " is missing or damaged");
       r.hit = true;
       return r;
     } catch (const std::exception& e) {
@@ -172,7 +182,14 @@ CacheResult cached_compress(const fs::path& transfer_path, const meshes::Mesh& m
   }
   prepare(cache_dir);
   const prt::TransferSet transfer = prt::read_transfer(transfer_path);
-  cpca::write_compressed(r.path, run_compress(transfer, mesh, mesh_path, o, quiet));
+  cpca::CompressReport report;
+  cpca::write_compressed(r.path, run_compress(transfer, mesh, mesh_path, o, quiet, &report));
+  r.summary = {report.clustering_seconds(), report.error.average_squared_error,
+               report.error.relative_error};
+  char text[128];
+  const int n = std::snprintf(text, sizeof text, "%.9g %.9g %.9g\n", r.summary.clustering_seconds,
+                              r.summary.average_se, r.summary.relative_error);
+  common::write_file_atomically(summary, text, std::size_t(n));
   return r;
 }
 

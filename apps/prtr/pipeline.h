@@ -6,6 +6,7 @@
 // ~/.cache/prtr), named by an FNV-1a hash of everything that determines them:
 //   bake-<hash>.prtx   mesh content hash + every bake option
 //   cpca-<hash>.prtc   transfer payload checksum + every compression option
+//   cpca-<hash>.summary  that compression's clustering time and errors
 // Entries are written atomically, so an interrupted run leaves no entry (never half of one);
 // an entry that fails validation is reported, deleted and rebuilt.
 #pragma once
@@ -46,9 +47,22 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
                         const prt::BakeOptions& options, const std::filesystem::path& cache_dir,
                         bool quiet);
 
-// The cached compression of the transfer file `transfer_path`.
-CacheResult cached_compress(const std::filesystem::path& transfer_path, const meshes::Mesh& mesh,
-                            const std::string& mesh_path, const cpca::CompressOptions& options,
-                            const std::filesystem::path& cache_dir, bool quiet);
+// What a compression measured about itself, kept beside the cached set (a `.summary` file)
+// so that a cache hit can still report it.
+struct CompressionSummary {
+  double clustering_seconds = 0, average_se = 0, relative_error = 0;
+};
+
+struct CompressCacheResult : CacheResult {
+  CompressionSummary summary;
+};
+
+// The cached compression of the transfer file `transfer_path`; `rebuild` ignores an existing
+// entry (and replaces it).
+CompressCacheResult cached_compress(const std::filesystem::path& transfer_path,
+                                    const meshes::Mesh& mesh, const std::string& mesh_path,
+                                    const cpca::CompressOptions& options,
+                                    const std::filesystem::path& cache_dir, bool quiet,
+                                    bool rebuild = false);
 
 }  // namespace prtr_app
