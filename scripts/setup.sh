@@ -3,14 +3,18 @@
 # glmark2-data for the Stanford bunny, blender-data for the HDR probes), then configures and
 # builds in ./build. Idempotent and non-interactive: a second run installs nothing and
 # rebuilds only what changed. Debian 12 (bookworm); runs apt-get as root or through sudo.
+#
+# The list is what a pristine Debian 12 root needs, proven by .ci/run on every submission.
+# openimageio-tools looks optional but is not: Debian's OpenImageIO CMake config declares
+# imported targets for its command-line tools, and find_package fails when they are absent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
-  libopenimageio-dev libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev libmetis-dev
-  libmeshoptimizer-dev
+  libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
+  libmetis-dev libmeshoptimizer-dev
   glmark2-data blender-data
 )
 
