@@ -1,5 +1,5 @@
-// Issue 6: the triangles the multipass renderer draws (GL_PRIMITIVES_GENERATED per pass)
-// equal the cost model's prediction (cpca::overdraw) for every strategy and several budgets;
+// Thesis ch. 4.1 (eq. 8): the triangles the multipass renderer draws (GL_PRIMITIVES_GENERATED per
+// pass) equal the cost model's prediction (cpca::overdraw) for every strategy and several budgets;
 // the false-colour pictures put the right colours where hand-placed triangles project; the
 // benchmark's report renders its rows.
 #include "cpca/supercluster.h"

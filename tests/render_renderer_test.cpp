@@ -23,7 +23,7 @@
 namespace {
 
 // GL float sums of ~300 products against double: rounding stays near 1e-6 of the largest
-// radiance; 1e-4 is the bound and leaves room for llvmpipe's fused multiply-adds.
+// radiance; 1e-4 leaves room for llvmpipe's fused multiply-adds.
 constexpr double kVertexTolerance = 1e-4;
 // Passes add the same interpolated values in another order: float rounding only.
 constexpr double kImageTolerance = 1e-5;

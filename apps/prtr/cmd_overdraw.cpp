@@ -1,4 +1,4 @@
-// prtr overdraw MESH --probe PROBE: the overdraw benchmark of issue 6, reproducing the
+// prtr overdraw MESH --probe PROBE: the overdraw benchmark, reproducing the
 // thesis's tables 5.2-5.17 (ch. 5) on our meshes.
 //
 // For every cluster count K and method row (original CPCA, CPCA overdraw reduction, geometry
@@ -419,7 +419,7 @@ Runner add_overdraw_command(CLI::App& app) {
             const render::TimingSummary t =
                 render::measure(r, camera, lighting, Eigen::Matrix3d::Identity(), axis,
                                 o.degrees_per_frame, o.frames, o.warmup);
-            // The issue's check: the triangles GL counted are the cost model's prediction.
+            // The triangles GL counted are the cost model's prediction.
             const render::RenderStats& stats = r.stats();
             if (stats.measured_triangles != od.triangles_per_pass ||
                 stats.triangles_per_pass != od.triangles_per_pass) {

@@ -1,6 +1,6 @@
 // prtr render COMPRESSED --probe PROBE -o out.exr: relight a compressed bake with OpenGL
 // (OSMesa/llvmpipe), write linear EXR (+ tone-mapped PNG) and report passes, overdraw and
-// frame times (issue 5; render/renderer.h describes the modes).
+// frame times (render/renderer.h describes the modes).
 #include "commands.h"
 #include "pass_grouping.h"
 #include "view_flags.h"

@@ -1,5 +1,5 @@
 // cpca/compressed.h: a clustered-PCA compressed transfer set, in memory (thesis eq. 6,
-// DESIGN.md "CPCA"). This is what the renderer consumes.
+// docs/ARCHITECTURE.md "Compression"). This is what the renderer consumes.
 //
 // The data compressed is one row per vertex, x_p = vec(M_p) over all channels, in the
 // layout of prt::TransferSet: channel-major, then the row-major n x cols matrix

@@ -1,6 +1,6 @@
 // render/renderer.h: relights a CPCA-compressed mesh with OpenGL (OSMesa/llvmpipe) into an
-// offscreen RGBA32F + depth framebuffer. Thesis ch. 3.2 and 4.1; DESIGN.md "Rendering,
-// super-clusters, overdraw"; issue 5.
+// offscreen RGBA32F + depth framebuffer. Thesis ch. 3.2 and 4.1; docs/ARCHITECTURE.md
+// "Rendering".
 //
 // Modes (all give the same image up to float rounding; tests hold them to it):
 //  - multipass:    depth pre-pass, then one additive pass per super-cluster with GL_EQUAL
@@ -123,9 +123,9 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// The median-of-frames measurement of issue 5: `warmup` frames, then `frames` frames, each
-// with the environment rotated by `degrees_per_frame` more about `axis` (so constants are
-// recomputed every frame, inside the timing), each ended by glFinish.
+// The median-of-frames measurement (docs/ARCHITECTURE.md "Rendering", Timing): `warmup` frames,
+// then `frames` frames, each with the environment rotated by `degrees_per_frame` more about `axis`
+// (so constants are recomputed every frame, inside the timing), each ended by glFinish.
 struct TimingSummary {
   int frames = 0;
   double frame_ms_median = 0, cpu_ms_median = 0, gl_ms_median = 0;
