@@ -59,14 +59,25 @@ DataLayout resolve_layout(const DataLayout& given, Eigen::Index d) {
                                   "the data dimension " + std::to_string(d));
     return given;
   }
+  // A size two layouts share (16: diffuse order 4 or glossy order 2) is refused rather than
+  // guessed: a wrong guess compresses without complaint and renders nonsense.
+  std::vector<DataLayout> matches;
+  std::string names;
   for (int channels : {1, 3})
     for (bool glossy : {false, true})
       for (int order = 1; order <= 10; ++order) {
         const DataLayout l{order, channels, glossy ? order * order : 1};
-        if (size(l) == d) return l;
+        if (size(l) != d) continue;
+        matches.push_back(l);
+        names += std::string(names.empty() ? "" : " or ") + (glossy ? "glossy" : "diffuse") +
+                 " order " + std::to_string(order) + (channels == 3 ? " RGB" : " grey");
       }
-  throw std::invalid_argument("compress: data dimension " + std::to_string(d) +
-                              " is not the size of an SH transfer vector or matrix");
+  if (matches.size() == 1) return matches.front();
+  if (matches.empty())
+    throw std::invalid_argument("compress: data dimension " + std::to_string(d) +
+                                " is not the size of an SH transfer vector or matrix");
+  throw std::invalid_argument("compress: data dimension " + std::to_string(d) + " fits " + names +
+                              "; set CompressOptions::layout to say which");
 }
 
 }  // namespace
