@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include "common/enum_names.h"
 #include "gl_program.h"
 #include "prt/sh_rotation.h"
 #include "render/gl_context.h"
@@ -54,28 +55,24 @@ void uint_attribute(GLuint vao, GLuint location, GLuint buffer) {
 
 }  // namespace
 
+namespace {
+constexpr common::EnumName<Mode> kModeNames[] = {{Mode::kMultipass, "multipass"},
+                                                 {Mode::kSinglepass, "singlepass"},
+                                                 {Mode::kDecoupled, "decoupled"},
+                                                 {Mode::kUncompressed, "uncompressed"},
+                                                 {Mode::kCpu, "cpu"}};
+}  // namespace
+
 const char* mode_name(Mode mode) {
-  switch (mode) {
-    case Mode::kMultipass:
-      return "multipass";
-    case Mode::kSinglepass:
-      return "singlepass";
-    case Mode::kDecoupled:
-      return "decoupled";
-    case Mode::kUncompressed:
-      return "uncompressed";
-    case Mode::kCpu:
-      return "cpu";
-  }
-  return "?";
+  return common::enum_name<Mode>(kModeNames, mode);
 }
 
 Mode parse_mode(const std::string& name) {
-  for (Mode m :
-       {Mode::kMultipass, Mode::kSinglepass, Mode::kDecoupled, Mode::kUncompressed, Mode::kCpu})
-    if (name == mode_name(m)) return m;
-  throw std::invalid_argument("unknown render mode '" + name +
-                              "'; use multipass, singlepass, decoupled, uncompressed or cpu");
+  return common::parse_enum<Mode>(kModeNames, name, "render mode");
+}
+
+std::vector<std::string> mode_names() {
+  return common::enum_names<Mode>(kModeNames);
 }
 
 struct Renderer::Impl {
@@ -160,11 +157,9 @@ void Renderer::Impl::build_groups(const cpca::CompressedSet& set, const meshes::
                                   cpca::SuperClusters& groups,
                                   std::vector<std::vector<std::uint32_t>>& lists) {
   const int registers = layout.registers_per_cluster();
-  GLint max_vectors = 0, max_block = 0, align = 16;
-  glGetIntegerv(GL_MAX_VERTEX_UNIFORM_VECTORS, &max_vectors);
-  glGetIntegerv(GL_MAX_UNIFORM_BLOCK_SIZE, &max_block);
+  GLint align = 16;
   glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &align);
-  const int context_budget = std::min<int>(max_vectors, max_block / 16);
+  const int context_budget = current_gl_info().default_register_budget();
   int budget = options.register_budget > 0 ? options.register_budget : context_budget;
   if (budget > context_budget)
     throw std::invalid_argument("--register-budget " + std::to_string(budget) +
@@ -350,8 +345,6 @@ void Renderer::Impl::upload_mesh(const meshes::Mesh& source, const cpca::Compres
     uint_attribute(vao, kAttrPass, vbo_pass);
     const int N = set->component_count;
     const int vectors = (N + 3) / 4;
-    GLint max_attribs = 16;
-    glGetIntegerv(GL_MAX_VERTEX_ATTRIBS, &max_attribs);
     if (compressed_gl() && kAttrWeights + vectors > kAttrRadiance)
       throw std::invalid_argument(std::to_string(N) + " PCs need " + std::to_string(vectors) +
                                   " weight attributes but the GL context offers " +

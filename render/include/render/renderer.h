@@ -46,14 +46,15 @@
 namespace render {
 
 enum class Mode { kMultipass, kSinglepass, kDecoupled, kUncompressed, kCpu };
-const char* mode_name(Mode mode);  // "multipass", ...
+const char* mode_name(Mode mode);  // "multipass", ...; "unknown" out of range
 // Throws std::invalid_argument listing the valid names.
 Mode parse_mode(const std::string& name);
+std::vector<std::string> mode_names();
 
 struct RendererOptions {
   Mode mode = Mode::kMultipass;
-  // vec4 registers a pass may use; 0 = what the context offers (the smaller of
-  // GL_MAX_VERTEX_UNIFORM_VECTORS and GL_MAX_UNIFORM_BLOCK_SIZE / 16).
+  // vec4 registers a pass may use; 0 = what the context offers
+  // (GlInfo::default_register_budget).
   int register_budget = 0;
   // Clusters per pass; 0 = as many as the budget holds. More than the budget holds is an error.
   int clusters_per_pass = 0;
