@@ -287,18 +287,7 @@ Header encode_header(const CompressedSet& set, const Sizes& sizes) {
   return h;
 }
 
-CompressedSet read(const fs::path& path, bool with_payload) {
-  const std::string name = path.string();
-  const auto fail = [&](const std::string& problem) {
-    return CompressedFileError(name + ": " + problem);
-  };
-
-  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
-  if (!opened.problem.empty()) throw fail(opened.problem);
-  std::ifstream& in = opened.stream;
-  const std::uintmax_t size = opened.size;
-  const Header& h = opened.header;
-
+Fields decode_fields(const Header& h) {
   Fields f;
   f.order = common::get_field<std::uint32_t>(h, kOffOrder);
   f.channels = common::get_field<std::uint32_t>(h, kOffChannels);
@@ -312,6 +301,58 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   f.mesh_path_bytes = common::get_field<std::uint32_t>(h, kOffMeshPathBytes);
   f.vertex_count = common::get_field<std::uint64_t>(h, kOffVertexCount);
   f.alpha = common::get_field<double>(h, kOffAlpha);
+  return f;
+}
+
+// The set's header fields (checked fields `f`; the hashes straight from the header).
+CompressedSet set_from(const Fields& f, const Header& h) {
+  CompressedSet set;
+  set.order = int(f.order);
+  set.channels = int(f.channels);
+  set.columns = int(f.columns);
+  set.vertex_count = f.vertex_count;
+  set.cluster_count = int(f.clusters);
+  set.component_count = int(f.components);
+  set.method = static_cast<ClusterMethod>(f.method);
+  set.solver = static_cast<PcaSolver>(f.solver);
+  set.overdraw_reduction = f.overdraw != 0;
+  set.iterations = int(f.iterations);
+  set.alpha = f.alpha;
+  set.seed = common::get_field<std::uint64_t>(h, kOffSeed);
+  set.mesh_hash = common::get_field<std::uint64_t>(h, kOffMeshHash);
+  set.transfer_hash = common::get_field<std::uint64_t>(h, kOffTransferHash);
+  return set;
+}
+
+// The mesh path block (path, then zero padding) against its checksum, or empty.
+std::string mesh_path_problem(const std::string& block, const Fields& f, const Header& h) {
+  const std::string path = block.substr(0, f.mesh_path_bytes);
+  if (std::string problem = common::checksum_problem(
+          "mesh path", common::fnv1a(path.data(), path.size()),
+          common::get_field<std::uint64_t>(h, kOffMeshPathChecksum), kFormat);
+      !problem.empty())
+    return problem;
+  if (const std::size_t i = first_bad_utf8(path); i != path.size())
+    return "mesh path is not UTF-8 (byte " + std::to_string(i) +
+           "); the file is damaged: " + kRecompress;
+  if (block.find_first_not_of('\0', f.mesh_path_bytes) != std::string::npos)
+    return "mesh path padding is not zero; the file is damaged: " + std::string(kRecompress);
+  return {};
+}
+
+CompressedSet read(const fs::path& path, bool with_payload) {
+  const std::string name = path.string();
+  const auto fail = [&](const std::string& problem) {
+    return CompressedFileError(name + ": " + problem);
+  };
+
+  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
+  if (!opened.problem.empty()) throw fail(opened.problem);
+  std::ifstream& in = opened.stream;
+  const std::uintmax_t size = opened.size;
+  const Header& h = opened.header;
+
+  const Fields f = decode_fields(h);
   if (const std::string problem = field_problem(f); !problem.empty()) {
     throw fail(problem + " in the header; the file is damaged: " + kRecompress);
   }
@@ -339,21 +380,7 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   };
   if (size != expected_size) throw size_problem(size);
 
-  CompressedSet set;
-  set.order = int(f.order);
-  set.channels = int(f.channels);
-  set.columns = int(f.columns);
-  set.vertex_count = f.vertex_count;
-  set.cluster_count = int(f.clusters);
-  set.component_count = int(f.components);
-  set.method = static_cast<ClusterMethod>(f.method);
-  set.solver = static_cast<PcaSolver>(f.solver);
-  set.overdraw_reduction = f.overdraw != 0;
-  set.iterations = int(f.iterations);
-  set.alpha = f.alpha;
-  set.seed = common::get_field<std::uint64_t>(h, kOffSeed);
-  set.mesh_hash = common::get_field<std::uint64_t>(h, kOffMeshHash);
-  set.transfer_hash = common::get_field<std::uint64_t>(h, kOffTransferHash);
+  CompressedSet set = set_from(f, h);
 
   // The file size was checked, so a short read below means the file changed under us.
   std::size_t offset = kHeaderBytes;
@@ -365,18 +392,8 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   std::string block(path_block, '\0');
   read_into(block.data(), path_block);
   set.mesh_path = block.substr(0, f.mesh_path_bytes);
-  if (const std::string problem = common::checksum_problem(
-          "mesh path", common::fnv1a(set.mesh_path.data(), set.mesh_path.size()),
-          common::get_field<std::uint64_t>(h, kOffMeshPathChecksum), kFormat);
-      !problem.empty())
+  if (const std::string problem = mesh_path_problem(block, f, h); !problem.empty())
     throw fail(problem);
-  if (const std::size_t i = first_bad_utf8(set.mesh_path); i != set.mesh_path.size()) {
-    throw fail("mesh path is not UTF-8 (byte " + std::to_string(i) +
-               "); the file is damaged: " + kRecompress);
-  }
-  if (block.find_first_not_of('\0', f.mesh_path_bytes) != std::string::npos) {
-    throw fail("mesh path padding is not zero; the file is damaged: " + std::string(kRecompress));
-  }
   if (!with_payload) return set;
 
   set.cluster_of.resize(sizes.ids);
