@@ -193,8 +193,8 @@ run relight "$tmp/cube.obj" --probe x.exr --degrees inf
 expect_code 2 && [[ $err == *--degrees* ]]; check "relight: --degrees inf is a usage error naming it" $?
 run relight "$tmp/cube.obj" --probe x.exr --exposure nan
 expect_code 2 && [[ $err == *--exposure* ]]; check "relight: --exposure nan is a usage error naming it" $?
-run overdraw "$tmp/cube.obj" --probe x.exr --alpha -inf
-expect_code 2 && [[ $err == *--alpha* ]]; check "overdraw: --alpha -inf is a usage error naming it" $?
+run overdraw "$tmp/cube.obj" --probe x.exr --alpha inf
+expect_code 2 && [[ $err == *--alpha* ]]; check "overdraw: --alpha inf is a usage error naming it" $?
 
 echo "cli: $passed passed, $failed failed"
 ((failed == 0))
