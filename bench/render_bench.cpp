@@ -1,12 +1,14 @@
 // render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P] [--frames F] [--width W]
-// [--height H]: issue 5's benchmark, every configuration in one run so the ratios are fair.
+// [--height H]: the render benchmark (docs/ARCHITECTURE.md "Rendering", Measured), every
+// configuration in one run so the ratios are fair.
 //
 // Bunny, 256 clusters x 8 PCs, order 6, 1280 x 948 (the thesis's setting): FPS and average
 // overdraw for multipass at the context's register budget, multipass at 3 clusters per pass
 // (the thesis's 256-register GPU), decoupled, single-pass, uncompressed (with --transfer) and
 // CPU-shaded; plus the bare trivial-shader floor on the same mesh and each mode's frame time
 // as a ratio to it. Plain main() rather than Google Benchmark: each row is a median over
-// frames with glFinish, which is what the issue asks for. Lighting rotates every frame.
+// frames with glFinish, and lighting rotates every frame so constants are recomputed inside
+// the timing.
 #include "cpca/compressed_file.h"
 #include "meshes/load.h"
 #include "probes/load.h"

@@ -1,4 +1,4 @@
-// Micro-benchmarks of the SH toolkit (issue: foundation). Figures are per item so runs on
+// Micro-benchmarks of the SH toolkit (prt/sh.h). Figures are per item so runs on
 // different machines compare; quote them as ratios against a baseline from the same run.
 #include "probes/load.h"
 #include "probes/procedural.h"

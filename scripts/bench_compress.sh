@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Compression benchmark (issue 4): clustering time, iterations, Average SE, relative error
+# Compression benchmark (docs/BENCHMARKS.md): clustering time, iterations, Average SE, relative error
 # and compression ratio for 64/128/192/256 clusters x 8 PCs, with and without geometry
 # coherence and the overdraw-aware reassignment, plus power iteration vs Eigen's solver.
 # Usage: scripts/bench_compress.sh [TRANSFER.prtx] [MESH]   (defaults: the bunny bake in out/)

@@ -1,4 +1,6 @@
 #include "common/atomic_file.h"
+#include "common/check.h"
+#include "common/enum_names.h"
 #include "common/hash.h"
 
 #include "test_support.h"
@@ -64,6 +66,36 @@ TEST(AtomicFile, MissingDirectoryNamesTarget) {
     FAIL() << "expected IoError";
   } catch (const common::IoError& e) {
     EXPECT_NE(std::string(e.what()).find("out.bin"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Dcheck, ReleaseBuildsDoNotEvaluateTheCondition) {
+  int evaluated = 0;
+  auto condition = [&] {
+    ++evaluated;
+    return true;
+  };
+  PRTR_DCHECK(condition());
+#ifdef NDEBUG
+  EXPECT_EQ(evaluated, 0);
+#else
+  EXPECT_EQ(evaluated, 1);
+  EXPECT_DEATH(PRTR_DCHECK(evaluated == 0), "internal invariant failed: evaluated == 0");
+#endif
+}
+
+enum class Colour { kRed, kGreen };
+constexpr common::EnumName<Colour> kColours[] = {{Colour::kRed, "red"}, {Colour::kGreen, "green"}};
+
+TEST(EnumNames, NamesParseBackAndUnknownValuesSayUnknown) {
+  for (const common::EnumName<Colour>& c : kColours)
+    EXPECT_EQ(common::parse_enum<Colour>(kColours, c.name, "colour"), c.value);
+  EXPECT_STREQ(common::enum_name<Colour>(kColours, static_cast<Colour>(7)), "unknown");
+  try {
+    common::parse_enum<Colour>(kColours, "blue", "colour");
+    ADD_FAILURE() << "blue parsed";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "unknown colour 'blue'; use red or green");
   }
 }
 

@@ -46,6 +46,7 @@ TEST(Compress, AffineSubspacesAreRecoveredExactly) {
   for (cpca::ClusterMethod method : {cpca::ClusterMethod::kLbg, cpca::ClusterMethod::kIterative}) {
     for (cpca::PcaSolver solver : {cpca::PcaSolver::kPowerIteration, cpca::PcaSolver::kEigen}) {
       cpca::CompressOptions o;
+      o.layout = {4, 3, 1};  // 48 numbers: diffuse RGB order 4 (glossy RGB order 2 too)
       o.clusters = 5;
       o.components = 3;
       o.method = method;
@@ -132,6 +133,7 @@ TEST(Compress, IterativeCpcaNeverLosesToLbgPlusPca) {
 TEST(SubspaceDistances, MatchReconstructionOfEveryPointInEveryCluster) {
   const cpca::DataMatrix x = affine_subspaces(3, 40, 4, 16, 7);
   cpca::CompressOptions o;
+  o.layout = {4, 1, 1};
   o.clusters = 4;
   o.components = 2;
   const cpca::CompressedSet set = cpca::compress(x, o);
@@ -173,6 +175,7 @@ TEST(OverdrawReduction, FewerStraddlingTrianglesWithinTheErrorBudget) {
       x(i, j) = std::sin(3.f * p.x() * float(j + 1)) + std::cos(2.f * p.y() * float(j)) + n(rng);
   }
   cpca::CompressOptions o;
+  o.layout = {4, 1, 1};
   o.clusters = 16;
   o.components = 3;
   cpca::CompressReport before, after;
@@ -220,6 +223,34 @@ TEST(Compress, RejectsBadParametersWithTheirNames) {
   EXPECT_THROW(cpca::compress(bad, o), std::invalid_argument);
 }
 
+TEST(Compress, AmbiguousDimensionIsRefusedNotGuessed) {
+  // 16 numbers are diffuse order 4 or glossy order 2, 81 diffuse order 9 or glossy order 3:
+  // without a layout the data cannot say which, and a guess renders nonsense.
+  for (int d : {16, 81}) {
+    const cpca::DataMatrix x = affine_subspaces(2, 10, 2, d, 1);
+    cpca::CompressOptions o;
+    o.clusters = 2;
+    o.components = 1;
+    try {
+      cpca::compress(x, o);
+      ADD_FAILURE() << d << " numbers were accepted without a layout";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("diffuse order"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("glossy order"), std::string::npos) << e.what();
+    }
+    o.layout = {d == 16 ? 2 : 3, 1, d == 16 ? 4 : 9};
+    const cpca::CompressedSet set = cpca::compress(x, o);
+    EXPECT_TRUE(set.glossy());
+  }
+  // An unambiguous size is still inferred: 9 numbers are only diffuse order 3.
+  cpca::CompressOptions o;
+  o.clusters = 2;
+  o.components = 1;
+  const cpca::CompressedSet set = cpca::compress(affine_subspaces(2, 10, 2, 9, 1), o);
+  EXPECT_EQ(set.order, 3);
+  EXPECT_FALSE(set.glossy());
+}
+
 }  // namespace
 
 namespace {
@@ -227,6 +258,7 @@ namespace {
 TEST(SubspaceDistances, CandidateRestrictionAgreesWithTheFullMatrix) {
   const cpca::DataMatrix x = affine_subspaces(6, 30, 3, 16, 9);
   cpca::CompressOptions o;
+  o.layout = {4, 1, 1};
   o.clusters = 6;
   o.components = 2;
   const cpca::CompressedSet set = cpca::compress(x, o);

@@ -1,5 +1,5 @@
-// Issue 6: the triangles the multipass renderer draws (GL_PRIMITIVES_GENERATED per pass)
-// equal the cost model's prediction (cpca::overdraw) for every strategy and several budgets;
+// Thesis ch. 4.1 (eq. 8): the triangles the multipass renderer draws (GL_PRIMITIVES_GENERATED per
+// pass) equal the cost model's prediction (cpca::overdraw) for every strategy and several budgets;
 // the false-colour pictures put the right colours where hand-placed triangles project; the
 // benchmark's report renders its rows.
 #include "cpca/supercluster.h"
@@ -92,12 +92,15 @@ TEST(OverdrawRenderer, MeasuredTrianglesEqualTheCostModelForEveryStrategyAndBudg
       render::Renderer renderer(mesh, &set, nullptr, nullptr, ro);
       renderer.render(camera, prt::ShLighting::Ones(4, 3), Eigen::Matrix3d::Identity());
       const render::RenderStats& stats = renderer.stats();
-      EXPECT_EQ(stats.passes, int(groups.passes.size()));
+      // GL's counts are the independent side: one query per pass, at least as many passes as
+      // the capacity forces, and the reported overdraw is what GL drew over the mesh.
+      ASSERT_EQ(stats.measured_triangles.size(), std::size_t(stats.passes));
+      EXPECT_GE(stats.passes, (set.cluster_count + per_pass - 1) / per_pass);
       EXPECT_EQ(stats.measured_triangles, predicted.triangles_per_pass);
       std::uint64_t drawn = 0;
       for (std::uint64_t m : stats.measured_triangles) drawn += m;
       EXPECT_EQ(drawn, predicted.triangles_drawn);
-      EXPECT_DOUBLE_EQ(stats.average_overdraw, predicted.average_overdraw);
+      EXPECT_DOUBLE_EQ(stats.average_overdraw, double(drawn) / double(mesh.triangle_count()));
       // One pass draws every triangle once; with several, patches' borders are drawn again.
       if (per_pass == set.cluster_count) {
         EXPECT_EQ(drawn, mesh.triangle_count());

@@ -42,7 +42,7 @@ TEST_P(PowerIterationShapes, MatchesEigenSolver) {
   const cpca::PcaResult oracle = cpca::eigen_pca(f, k);
   EXPECT_EQ(pi.gram, shape.m < shape.n);
   for (int p = 0; p < k; ++p) {
-    // Eigenvalues within 1e-4 relative (the bound; measured ~1e-12 with these gaps).
+    // Eigenvalues within 1e-4 relative (the bound we hold it to; measured ~1e-12 with these gaps).
     EXPECT_NEAR(pi.eigenvalues[p], oracle.eigenvalues[p], 1e-4 * oracle.eigenvalues[p]);
     EXPECT_NEAR(pi.eigenvalues[p], std::pow(10.0 * std::pow(0.7, p), 2), 1e-6 * pi.eigenvalues[p]);
     // Same direction up to sign.

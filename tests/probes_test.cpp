@@ -162,7 +162,13 @@ TEST(BrightPixel, LandsWhereTheConventionSays) {
   const Rgb bright(100, 200, 300);
   const Probe p = black_with_bright(w, h, bx, by, bright);
   const Eigen::Vector3d d = p.pixel_direction(bx, by);
-  expect_near3(d, latlong_direction((bx + 0.5) / w, (by + 0.5) / h), 1e-15);
+  // The convention of probes/probe.h written out here, not through latlong_direction:
+  // theta from +Y, phi = 2 pi u, d = (-sin theta sin phi, cos theta, sin theta cos phi).
+  const double theta = std::numbers::pi * (by + 0.5) / h,
+               phi = 2 * std::numbers::pi * (bx + 0.5) / w;
+  expect_near3(d,
+               {-std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi)},
+               1e-15);
   EXPECT_NEAR(d.norm(), 1.0, 1e-15);
   EXPECT_EQ(p.lookup_nearest(d), bright);
   EXPECT_EQ(p.lookup(d), bright);  // exactly at a pixel centre: no blending
@@ -721,11 +727,38 @@ void check_real_probe(const fs::path& path) {
   // Blender's probes are DWAB-compressed (lossy) and decode with a few tiny negative texels
   // (down to about -0.004), which the loader clamps: a handful, never a large part.
   EXPECT_LT(report.negative_texels_clamped, p.texels().size() / 100);
-  for (const Rgb& t : p.texels()) {
-    ASSERT_TRUE(t.allFinite());
-    ASSERT_TRUE((t.array() >= 0.0f).all());
+  // The oracle is the file read directly with OpenImageIO: every texel is the file's, clamped
+  // at zero (bit-exact), the clamp count is the file's negatives, and the mean is the
+  // solid-angle sum over rows (cos theta_top - cos theta_bottom) 2 pi / W, over 4 pi.
+  auto in = OIIO::ImageInput::open(path.string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const int w = in->spec().width, h = in->spec().height, channels = in->spec().nchannels;
+  ASSERT_GE(channels, 3);
+  std::vector<float> file(std::size_t(w) * h * channels);
+  ASSERT_TRUE(in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, file.data()));
+  ASSERT_EQ(std::size_t(w) * h, p.texels().size());
+  std::uint64_t negatives = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int y = 0; y < h; ++y) {
+    const double solid_angle =
+        2 * std::numbers::pi / w *
+        (std::cos(std::numbers::pi * y / h) - std::cos(std::numbers::pi * (y + 1) / h));
+    for (int x = 0; x < w; ++x) {
+      const float* f = file.data() + (std::size_t(y) * w + x) * channels;
+      bool negative = false;
+      for (int c = 0; c < 3; ++c) {
+        negative |= f[c] < 0.0f;
+        const float expected = std::max(f[c], 0.0f);
+        ASSERT_EQ(p.texel(x, y)[c], expected) << "texel (" << x << ", " << y << ")";
+        sum[c] += solid_angle * expected;
+      }
+      negatives += negative;
+    }
   }
-  EXPECT_TRUE((p.mean_radiance().array() > 0.0f).all());
+  EXPECT_EQ(report.negative_texels_clamped, negatives);
+  const Eigen::Vector3d expected_mean = sum / (4 * std::numbers::pi);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(p.mean_radiance()[c], expected_mean[c], 1e-5 * expected_mean[c]) << "channel " << c;
   const Rgb m = p.max_texel(), mean = p.mean_radiance();
   std::printf("  %-10s max (%g, %g, %g)  mean (%g, %g, %g)\n", path.stem().c_str(), m.x(), m.y(),
               m.z(), mean.x(), mean.y(), mean.z());

@@ -86,8 +86,8 @@ TEST(Sh, FloatAndBatchAgreeWithDouble) {
 
 TEST(Sh, OrthonormalAtOrder10ByQuadrature) {
   // Product quadrature exact for polynomials of degree <= 2*9 in (x, y, z): Gauss-Legendre
-  // in z with 12 nodes and 24 equally spaced phi. Max |<y_i, y_j> - delta_ij| < 1e-5 as the
-  // issue asks; with exact quadrature it is ~1e-14.
+  // in z with 12 nodes and 24 equally spaced phi. Max |<y_i, y_j> - delta_ij| < 1e-5; with exact
+  // quadrature it is ~1e-14.
   std::vector<double> gx, gw;
   gauss_legendre(12, gx, gw);
   const int nphi = 24;

@@ -1,6 +1,6 @@
-// Super-cluster strategies (issue 6): hand-counted overdraw on hand-made meshes, the thesis's
-// worked example (Fig. 4.7), capacity/coverage invariants on random inputs, refinement never
-// worse than its start, and a brute-force oracle over all groupings of tiny cluster counts.
+// Super-cluster strategies (thesis ch. 4.3): hand-counted overdraw on hand-made meshes, the
+// thesis's worked example (Fig. 4.7), capacity/coverage invariants on random inputs, refinement
+// never worse than its start, and a brute-force oracle over all groupings of tiny cluster counts.
 #include "cpca/supercluster.h"
 #include "cpca/supercluster_greedy.h"
 #include "cpca/supercluster_incidence.h"
@@ -304,7 +304,7 @@ void for_each_grouping(int k, int per_pass,
 }
 
 TEST(SuperclusterOracle, TinyClusterCountsAgainstBruteForce) {
-  // Tolerance: the issue asks how close the best strategy gets to the optimum; on these
+  // Tolerance: this measures how close the best strategy gets to the optimum; on these
   // sizes iterated local search is expected to be exact, so any gap fails. Greedy's and
   // METIS's gaps are printed as the report's figures, not asserted.
   double worst_greedy = 0.0, worst_metis = 0.0;

@@ -16,8 +16,9 @@ Runner add_gl_info_command(CLI::App& app) {
                 info.core_profile ? "core" : "compatibility");
     std::printf("renderer    %s\n", info.renderer.c_str());
     std::printf("glsl        %s\n", info.glsl_version.c_str());
-    std::printf("registers   %d vec4 vertex uniforms (default register budget)\n",
-                info.max_vertex_uniform_vectors);
+    std::printf("registers   %d vec4 vertex uniforms\n", info.max_vertex_uniform_vectors);
+    std::printf("budget      %d vec4 (default register budget per pass)\n",
+                info.default_register_budget());
     std::printf("ubo         %d bytes max uniform block\n", info.max_uniform_block_size);
     std::printf("ssbo        %lld bytes max storage block\n", info.max_ssbo_size);
   };

@@ -5,8 +5,10 @@
 // installed, an MP4.
 #include "bake_flags.h"
 #include "commands.h"
+#include "compress_flags.h"
 #include "contact_sheet.h"
 #include "cpca/compressed_file.h"
+#include "flag_checks.h"
 #include "meshes/load.h"
 #include "pass_grouping.h"
 #include "pipeline.h"
@@ -25,6 +27,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <regex>
@@ -73,173 +76,203 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+struct Options {
+  std::string mesh, probe, out = "out/relight", cache, mode = "decoupled";
+  std::string strategy = "greedy-refine";
+  BakeFlags bake;
+  ViewFlags view;
+  CompressFlags compress;
+  int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0;
+  double degrees = 360.0;
+  bool quiet = false, no_video = false;
+};
+
+void add_flags(CLI::App* cmd, Options& o) {
+  cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, OFF, STL, 3DS)")->required();
+  cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
+  cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
+  cmd->add_option("--frames", o.frames, "Frames in the sequence")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--degrees", o.degrees, "Total environment rotation over the sequence")
+      ->check(finite_number())
+      ->capture_default_str();
+  cmd->add_option("--mode", o.mode, "Rendering path (render/renderer.h)")
+      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}))
+      ->capture_default_str();
+  cmd->add_option("--strategy", o.strategy, "Super-cluster strategy for multipass/decoupled")
+      ->capture_default_str();
+  cmd->add_option("--register-budget", o.register_budget,
+                  "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
+  add_bake_flags(cmd, o.bake);
+  add_view_flags(cmd, o.view);
+  cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
+  cmd->add_option("--columns", o.columns, "Contact sheet columns")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  cmd->add_option("--thumbnail", o.thumbnail, "Contact sheet thumbnail width (pixels)")
+      ->check(CLI::Range(16, 4096))
+      ->capture_default_str();
+  cmd->add_option("--fps", o.fps, "Video frame rate")
+      ->check(CLI::Range(1, 240))
+      ->capture_default_str();
+  cmd->add_flag("--no-video", o.no_video, "Do not encode an MP4 even if ffmpeg is installed");
+  cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
+}
+
+// Usage errors the flags alone decide, before anything is read.
+void check_sizes(const prt::BakeOptions& bake, const cpca::CompressOptions& compress) {
+  const int n = bake.order * bake.order;
+  const std::size_t dimension = std::size_t(bake.material.channels()) * std::size_t(n) *
+                                std::size_t(bake.kind == prt::TransferKind::kGlossy ? n : 1);
+  if (std::size_t(compress.components) >= dimension)
+    throw UsageError("--pcs " + std::to_string(compress.components) +
+                     " must be below the transfer dimension " + std::to_string(dimension) +
+                     " (order " + std::to_string(bake.order) + ")");
+}
+
+void make_output_directory(const std::string& out) {
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  if (ec)
+    throw std::runtime_error("output directory " + out + " cannot be created (" + ec.message() +
+                             "); choose another --out");
+}
+
+// Bake and compress through the cache, reporting hits and times; the compressed set's path.
+fs::path bake_and_compress(const Options& o, const meshes::Mesh& mesh, const prt::BakeOptions& bake,
+                           const cpca::CompressOptions& compress) {
+  const fs::path cache = o.cache.empty() ? default_cache_dir() : fs::path(o.cache);
+  const auto t_bake = Clock::now();
+  const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
+  const double bake_s = seconds_since(t_bake);
+  const auto t_compress = Clock::now();
+  const CompressCacheResult compressed =
+      cached_compress(transfer.path, mesh, o.mesh, compress, cache, o.quiet);
+  const double compress_s = seconds_since(t_compress);
+  std::printf("bake        %s %s (%.1f s)\n", transfer.hit ? "cached" : "baked",
+              transfer.path.string().c_str(), bake_s);
+  std::printf("compress    %s %s (%.1f s)\n", compressed.hit ? "cached" : "compressed",
+              compressed.path.string().c_str(), compress_s);
+  return compressed.path;
+}
+
+std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::Mesh& mesh,
+                                                const cpca::CompressedSet& set,
+                                                const probes::Probe& probe,
+                                                const render::GlContext& context) {
+  render::RendererOptions ro;
+  ro.mode = render::parse_mode(o.mode);
+  ro.register_budget = o.register_budget;
+  if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
+    ro.groups = group_for_renderer(mesh, set, context, o.register_budget, 0, o.strategy);
+  try {
+    auto renderer = std::make_unique<render::Renderer>(mesh, &set, nullptr, &probe, ro);
+    renderer->set_background(resolve_background(o.view));
+    return renderer;
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
+struct FrameTimes {
+  std::vector<double> frame_ms, gl_ms, cpu_ms;
+  double seconds = 0;  // with EXR/PNG output
+};
+
+// The sequence: EXR and PNG per frame, thumbnails for the contact sheet.
+FrameTimes render_frames(const Options& o, render::Renderer& renderer, const render::Camera& camera,
+                         const prt::ShLighting& lighting, std::vector<render::Image>& thumbnails) {
+  const Eigen::Vector3d axis = resolve_axis(o.view);
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 2; ++i) renderer.render(camera, lighting, identity);  // warm-up
+  remove_old_frames(o.out);
+  ProgressBar bar(o.quiet);
+  FrameTimes times;
+  const auto start = Clock::now();
+  for (int f = 0; f < o.frames; ++f) {
+    bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
+    const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
+    const render::FrameTiming t = renderer.render(camera, lighting, prt::axis_angle(axis, angle));
+    times.frame_ms.push_back(t.total_ms);
+    times.gl_ms.push_back(t.gl_ms);
+    times.cpu_ms.push_back(t.cpu_ms);
+    const render::Image image = renderer.read_image();
+    render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
+    render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
+    thumbnails.push_back(downscale(image, o.thumbnail));
+  }
+  bar.finish();
+  times.seconds = seconds_since(start);
+  return times;
+}
+
+std::string make_video(const Options& o) {
+  if (o.no_video) return "skipped (--no-video)";
+  if (!have_ffmpeg()) return "skipped (ffmpeg is not installed)";
+  const fs::path mp4 = fs::path(o.out) / "relight.mp4";
+  return encode_video(o.out, mp4, o.fps) ? mp4.string() : "failed (ffmpeg reported an error)";
+}
+
+void print_summary(const Options& o, const render::RenderStats& st, const render::Camera& camera,
+                   const FrameTimes& t, const std::string& video, const fs::path& sheet,
+                   double total_s) {
+  std::printf("render      %s, %d pass(es), average overdraw %.3f, %d x %d\n", o.mode.c_str(),
+              st.passes, st.average_overdraw, camera.width, camera.height);
+  std::printf(
+      "frames      %d in %s: %.2f ms per frame median (%.1f FPS; CPU update %.2f ms, "
+      "GL %.2f ms), %.2f s with EXR/PNG output\n",
+      o.frames, o.out.c_str(), median(t.frame_ms), 1000.0 / median(t.frame_ms), median(t.cpu_ms),
+      median(t.gl_ms), t.seconds);
+  std::printf("video       %s\n", video.c_str());
+  std::printf("total       %.1f s\n", total_s);
+  std::printf("contact sheet: %s\n", sheet.string().c_str());
+}
+
 }  // namespace
 
 Runner add_relight_command(CLI::App& app) {
-  struct Options {
-    std::string mesh, probe, out = "out/relight", cache, mode = "decoupled";
-    std::string strategy = "greedy-refine", method = "lbg";
-    BakeFlags bake;
-    ViewFlags view;
-    cpca::CompressOptions compress;
-    int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0;
-    double degrees = 360.0;
-    bool quiet = false, no_video = false;
-  };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "relight",
       "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
       "previews, a contact sheet and an MP4");
-  cmd->add_option("MESH", opt->mesh, "Mesh file (OBJ, PLY, OFF, STL)")->required();
-  cmd->add_option("--probe", opt->probe, "Light probe (lat-long or angular EXR/HDR)")->required();
-  cmd->add_option("--out", opt->out, "Output directory")->capture_default_str();
-  cmd->add_option("--frames", opt->frames, "Frames in the sequence")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--degrees", opt->degrees, "Total environment rotation over the sequence")
-      ->capture_default_str();
-  cmd->add_option("--mode", opt->mode, "Rendering path (render/renderer.h)")
-      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}))
-      ->capture_default_str();
-  cmd->add_option("--strategy", opt->strategy, "Super-cluster strategy for multipass/decoupled")
-      ->capture_default_str();
-  cmd->add_option("--register-budget", opt->register_budget,
-                  "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cmd->add_option("--clusters", opt->compress.clusters, "CPCA clusters")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  cmd->add_option("--pcs", opt->compress.components, "Principal components per cluster")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  cmd->add_option("--method", opt->method, "lbg or iterative (CPCA)")
-      ->check(CLI::IsMember({"lbg", "iterative"}))
-      ->capture_default_str();
-  cmd->add_option("--alpha", opt->compress.alpha, "Geometry-coherence weight (0: off)")
-      ->check(CLI::Range(0.0, 1e6))
-      ->capture_default_str();
-  cmd->add_flag("--overdraw-reduction", opt->compress.overdraw_reduction,
-                "Overdraw-aware reassignment after clustering");
-  add_bake_flags(cmd, opt->bake);
-  add_view_flags(cmd, opt->view);
-  cmd->add_option("--cache", opt->cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
-  cmd->add_option("--columns", opt->columns, "Contact sheet columns")
-      ->check(CLI::Range(1, 64))
-      ->capture_default_str();
-  cmd->add_option("--thumbnail", opt->thumbnail, "Contact sheet thumbnail width (pixels)")
-      ->check(CLI::Range(16, 4096))
-      ->capture_default_str();
-  cmd->add_option("--fps", opt->fps, "Video frame rate")
-      ->check(CLI::Range(1, 240))
-      ->capture_default_str();
-  cmd->add_flag("--no-video", opt->no_video, "Do not encode an MP4 even if ffmpeg is installed");
-  cmd->add_flag("-q,--quiet", opt->quiet, "No progress bars");
+  add_flags(cmd, *opt);
 
   return [opt] {
-    Options& o = *opt;
-    using Clock = std::chrono::steady_clock;
+    const Options& o = *opt;
     const auto start = Clock::now();
     const prt::BakeOptions bake = resolve_bake_flags(o.bake);
-    o.compress.method =
-        o.method == "iterative" ? cpca::ClusterMethod::kIterative : cpca::ClusterMethod::kLbg;
-    const Eigen::Vector3d axis = resolve_axis(o.view);
-    const render::Background background = resolve_background(o.view);
-    const int n = bake.order * bake.order;
-    const std::size_t dimension = std::size_t(bake.material.channels()) * std::size_t(n) *
-                                  std::size_t(bake.kind == prt::TransferKind::kGlossy ? n : 1);
-    if (std::size_t(o.compress.components) >= dimension)
-      throw UsageError("--pcs " + std::to_string(o.compress.components) +
-                       " must be below the transfer dimension " + std::to_string(dimension) +
-                       " (order " + std::to_string(bake.order) + ")");
-
+    const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
+    resolve_axis(o.view);
+    resolve_background(o.view);
+    check_sizes(bake, compress);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
-    if (std::size_t(o.compress.clusters) > mesh.vertex_count())
-      throw UsageError("--clusters " + std::to_string(o.compress.clusters) + " exceeds the " +
+    if (std::size_t(compress.clusters) > mesh.vertex_count())
+      throw UsageError("--clusters " + std::to_string(compress.clusters) + " exceeds the " +
                        std::to_string(mesh.vertex_count()) + " vertices of " + o.mesh);
     const render::Camera camera = resolve_camera(o.view, mesh);
     const probes::Probe probe = probes::load_probe(o.probe);  // fail before the long work
-    std::error_code ec;
-    fs::create_directories(o.out, ec);
-    if (ec)
-      throw std::runtime_error("output directory " + o.out + " cannot be created (" + ec.message() +
-                               "); choose another --out");
-
-    const fs::path cache = o.cache.empty() ? default_cache_dir() : fs::path(o.cache);
-    const auto t_bake = Clock::now();
-    const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
-    const double bake_s = std::chrono::duration<double>(Clock::now() - t_bake).count();
-    const auto t_compress = Clock::now();
-    const CompressCacheResult compressed =
-        cached_compress(transfer.path, mesh, o.mesh, o.compress, cache, o.quiet);
-    const double compress_s = std::chrono::duration<double>(Clock::now() - t_compress).count();
-    std::printf("bake        %s %s (%.1f s)\n", transfer.hit ? "cached" : "baked",
-                transfer.path.string().c_str(), bake_s);
-    std::printf("compress    %s %s (%.1f s)\n", compressed.hit ? "cached" : "compressed",
-                compressed.path.string().c_str(), compress_s);
-
-    const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
+    make_output_directory(o.out);
+    const cpca::CompressedSet set =
+        cpca::read_compressed(bake_and_compress(o, mesh, bake, compress));
     const prt::ShLighting lighting = prt::project(probe, set.order);
     render::GlContext context;
-    render::RendererOptions ro;
-    ro.mode = render::parse_mode(o.mode);
-    ro.register_budget = o.register_budget;
-    if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
-      ro.groups = group_for_renderer(mesh, set, context, o.register_budget, 0, o.strategy);
-    std::optional<render::Renderer> renderer;
-    try {
-      renderer.emplace(mesh, &set, nullptr, &probe, ro);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
-    }
-    renderer->set_background(background);
-    const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
-    for (int i = 0; i < 2; ++i) renderer->render(camera, lighting, identity);  // warm-up
-
-    remove_old_frames(o.out);
-    ProgressBar bar(o.quiet);
-    std::vector<double> frame_ms, gl_ms, cpu_ms;
+    const auto renderer = make_renderer(o, mesh, set, probe, context);
     std::vector<render::Image> thumbnails;
-    const auto t_frames = Clock::now();
-    for (int f = 0; f < o.frames; ++f) {
-      bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
-      const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
-      const render::FrameTiming t =
-          renderer->render(camera, lighting, prt::axis_angle(axis, angle));
-      frame_ms.push_back(t.total_ms);
-      gl_ms.push_back(t.gl_ms);
-      cpu_ms.push_back(t.cpu_ms);
-      const render::Image image = renderer->read_image();
-      render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
-      render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
-      thumbnails.push_back(downscale(image, o.thumbnail));
-    }
-    bar.finish();
-    const double frames_s = std::chrono::duration<double>(Clock::now() - t_frames).count();
+    const FrameTimes times = render_frames(o, *renderer, camera, lighting, thumbnails);
     const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
     render::write_png(sheet, tile(thumbnails, o.columns), o.view.exposure);
-    std::string video = "skipped (--no-video)";
-    if (!o.no_video) {
-      const fs::path mp4 = fs::path(o.out) / "relight.mp4";
-      if (!have_ffmpeg())
-        video = "skipped (ffmpeg is not installed)";
-      else
-        video =
-            encode_video(o.out, mp4, o.fps) ? mp4.string() : "failed (ffmpeg reported an error)";
-    }
-    const render::RenderStats& st = renderer->stats();
-    std::printf("render      %s, %d pass(es), average overdraw %.3f, %d x %d\n", o.mode.c_str(),
-                st.passes, st.average_overdraw, camera.width, camera.height);
-    std::printf(
-        "frames      %d in %s: %.2f ms per frame median (%.1f FPS; CPU update %.2f ms, "
-        "GL %.2f ms), %.2f s with EXR/PNG output\n",
-        o.frames, o.out.c_str(), median(frame_ms), 1000.0 / median(frame_ms), median(cpu_ms),
-        median(gl_ms), frames_s);
-    std::printf("video       %s\n", video.c_str());
-    std::printf("total       %.1f s\n",
-                std::chrono::duration<double>(Clock::now() - start).count());
-    std::printf("contact sheet: %s\n", sheet.string().c_str());
+    const std::string video = make_video(o);
+    print_summary(o, renderer->stats(), camera, times, video, sheet, seconds_since(start));
   };
 }
 

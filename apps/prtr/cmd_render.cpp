@@ -1,7 +1,8 @@
 // prtr render COMPRESSED --probe PROBE -o out.exr: relight a compressed bake with OpenGL
 // (OSMesa/llvmpipe), write linear EXR (+ tone-mapped PNG) and report passes, overdraw and
-// frame times (issue 5; render/renderer.h describes the modes).
+// frame times (render/renderer.h describes the modes).
 #include "commands.h"
+#include "flag_checks.h"
 #include "pass_grouping.h"
 #include "view_flags.h"
 
@@ -18,6 +19,7 @@
 #include "render/renderer.h"
 
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -33,108 +35,156 @@ std::string json_list(const std::vector<std::uint64_t>& values) {
   return s + "]";
 }
 
-}  // namespace
+struct Options {
+  std::string compressed, probe, mesh, transfer, output, png, mode = "multipass";
+  std::string strategy = "order";
+  ViewFlags view;
+  double rotate_deg = 0.0, degrees_per_frame = 1.0;
+  int register_budget = 0, clusters_per_pass = 0, frames = 20, warmup = 3;
+  bool json = false, quiet = false, no_cull = false, no_reorder = false;
+};
 
-Runner add_render_command(CLI::App& app) {
-  struct Options {
-    std::string compressed, probe, mesh, transfer, output, png, mode = "multipass";
-    std::string strategy = "order";
-    ViewFlags view;
-    double rotate_deg = 0.0, degrees_per_frame = 1.0;
-    int register_budget = 0, clusters_per_pass = 0, frames = 20, warmup = 3;
-    bool json = false, quiet = false, no_cull = false, no_reorder = false;
-  };
-  auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "render", "Relight a compressed bake (.prtc) under a rotated probe; write EXR/PNG and FPS");
-  cmd->add_option("COMPRESSED", opt->compressed, "Compressed transfer file (.prtc)")->required();
-  cmd->add_option("--probe", opt->probe, "Light probe (lat-long or angular EXR/HDR)")->required();
-  cmd->add_option("-o,--output", opt->output, "EXR to write (linear RGB, alpha = coverage)")
+void add_flags(CLI::App* cmd, Options& o) {
+  cmd->add_option("COMPRESSED", o.compressed, "Compressed transfer file (.prtc)")->required();
+  cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
+  cmd->add_option("-o,--output", o.output, "EXR to write (linear RGB, alpha = coverage)")
       ->required();
-  cmd->add_option("--png", opt->png, "Also write a tone-mapped PNG");
-  cmd->add_option("--mesh", opt->mesh, "Mesh (default: the one the set was baked from)");
-  cmd->add_option("--mode", opt->mode, "Rendering path")
-      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "uncompressed", "cpu"}))
+  cmd->add_option("--png", o.png, "Also write a tone-mapped PNG");
+  cmd->add_option("--mesh", o.mesh, "Mesh (default: the one the set was baked from)");
+  cmd->add_option("--mode", o.mode, "Rendering path")
+      ->check(CLI::IsMember(render::mode_names()))
       ->capture_default_str();
-  cmd->add_option("--transfer", opt->transfer,
-                  "Raw transfer file (.prtx), for --mode uncompressed");
-  cmd->add_option("--rotate-deg", opt->rotate_deg, "Environment rotation angle (degrees)")
+  cmd->add_option("--transfer", o.transfer, "Raw transfer file (.prtx), for --mode uncompressed");
+  cmd->add_option("--rotate-deg", o.rotate_deg, "Environment rotation angle (degrees)")
+      ->check(finite_number())
       ->capture_default_str();
-  cmd->add_option("--register-budget", opt->register_budget,
+  cmd->add_option("--register-budget", o.register_budget,
                   "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_option("--clusters-per-pass", opt->clusters_per_pass,
+  cmd->add_option("--clusters-per-pass", o.clusters_per_pass,
                   "Clusters per pass (0: as many as the budget holds)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_option("--strategy", opt->strategy,
+  cmd->add_option("--strategy", o.strategy,
                   "Super-cluster strategy: " + cpca::supercluster_strategy_names())
       ->capture_default_str();
-  cmd->add_option("--frames", opt->frames, "Timed frames (median reported)")
+  cmd->add_option("--frames", o.frames, "Timed frames (median reported)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("--warmup", opt->warmup, "Untimed frames first")
+  cmd->add_option("--warmup", o.warmup, "Untimed frames first")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
-  cmd->add_option("--spin-deg", opt->degrees_per_frame,
+  cmd->add_option("--spin-deg", o.degrees_per_frame,
                   "Extra environment rotation per timed frame, so constants change every frame")
+      ->check(finite_number())
       ->capture_default_str();
-  add_view_flags(cmd, opt->view);
-  cmd->add_flag("--no-cull", opt->no_cull, "Draw back faces too (open meshes)");
-  cmd->add_flag("--no-reorder", opt->no_reorder,
+  add_view_flags(cmd, o.view);
+  cmd->add_flag("--no-cull", o.no_cull, "Draw back faces too (open meshes)");
+  cmd->add_flag("--no-reorder", o.no_reorder,
                 "Keep triangles in mesh order (no vertex-cache order)");
-  cmd->add_flag("--json", opt->json, "Print one JSON line of results");
-  cmd->add_flag("-q,--quiet", opt->quiet, "Print nothing but errors (and the --json line)");
+  cmd->add_flag("--json", o.json, "Print one JSON line of results");
+  cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors (and the --json line)");
+}
+
+// The renderer options the flags describe; usage errors for flags the mode does not read.
+render::RendererOptions renderer_options(const Options& o, const CLI::App* cmd) {
+  render::RendererOptions ro;
+  ro.mode = render::parse_mode(o.mode);
+  ro.register_budget = o.register_budget;
+  ro.clusters_per_pass = o.clusters_per_pass;
+  ro.cull_back_faces = !o.no_cull;
+  ro.optimize_vertex_cache = !o.no_reorder;
+  ro.count_primitives = ro.mode == render::Mode::kMultipass;
+  if (ro.mode == render::Mode::kUncompressed && o.transfer.empty())
+    throw UsageError("--mode uncompressed needs --transfer PRTX (the raw bake)");
+  if (ro.mode != render::Mode::kUncompressed && !o.transfer.empty())
+    throw UsageError("--transfer is only read by --mode uncompressed");
+  if (ro.mode != render::Mode::kMultipass && ro.mode != render::Mode::kDecoupled &&
+      (cmd->count("--clusters-per-pass") || cmd->count("--strategy")))
+    throw UsageError("--clusters-per-pass and --strategy apply to multipass and decoupled only");
+  return ro;
+}
+
+// The set's mesh (or --mesh), checked against the set's hash.
+meshes::Mesh load_checked_mesh(const Options& o, const cpca::CompressedSet& set) {
+  const std::string mesh_path = o.mesh.empty() ? set.mesh_path : o.mesh;
+  if (mesh_path.empty()) throw UsageError(o.compressed + " records no mesh path; pass --mesh MESH");
+  meshes::Mesh mesh = meshes::load_mesh(mesh_path);
+  if (meshes::content_hash(mesh) != set.mesh_hash)
+    throw std::runtime_error(o.compressed + " was baked from a different mesh than " + mesh_path +
+                             " (stale); bake and compress it again, or pass the right --mesh");
+  return mesh;
+}
+
+std::optional<prt::TransferSet> load_checked_transfer(const Options& o,
+                                                      const cpca::CompressedSet& set) {
+  if (o.transfer.empty()) return std::nullopt;
+  prt::TransferSet transfer = prt::read_transfer(o.transfer);
+  if (transfer.mesh_hash != set.mesh_hash)
+    throw std::runtime_error(o.transfer + " and " + o.compressed +
+                             " come from different meshes; use the bake the set was made from");
+  return transfer;
+}
+
+void print_report(const Options& o, const render::RenderStats& st,
+                  const render::TimingSummary& timing) {
+  if (!o.quiet) {
+    std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
+                o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
+    std::printf(
+        "mode        %s, %d pass(es), %d cluster(s) per pass, budget %d vec4 (%d per cluster)\n",
+        o.mode.c_str(), st.passes, st.clusters_per_pass, st.register_budget,
+        st.registers_per_cluster);
+    std::printf("overdraw    %.4f (%llu triangles, drawn per pass %s)\n", st.average_overdraw,
+                static_cast<unsigned long long>(st.triangle_count),
+                json_list(st.triangles_per_pass).c_str());
+    std::printf(
+        "timing      %.2f FPS: frame %.2f ms median (cpu update %.2f ms, gl %.2f ms) over %d "
+        "frames\n",
+        timing.fps, timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median,
+        timing.frames);
+  }
+  if (o.json) {
+    std::printf(
+        "{\"mode\":\"%s\",\"width\":%d,\"height\":%d,\"passes\":%d,\"triangles_per_pass\":%s,"
+        "\"average_overdraw\":%.6f,\"fps\":%.3f,\"frame_ms_median\":%.3f,"
+        "\"cpu_update_ms\":%.3f,\"gl_ms\":%.3f}\n",
+        o.mode.c_str(), o.view.width, o.view.height, st.passes,
+        json_list(st.triangles_per_pass).c_str(), st.average_overdraw, timing.fps,
+        timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median);
+  }
+}
+
+}  // namespace
+
+Runner add_render_command(CLI::App& app) {
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "render", "Relight a compressed bake (.prtc) under a rotated probe; write EXR/PNG and FPS");
+  add_flags(cmd, *opt);
 
   return [opt, cmd] {
-    Options& o = *opt;
-    render::RendererOptions ro;
-    ro.mode = render::parse_mode(o.mode);
-    ro.register_budget = o.register_budget;
-    ro.clusters_per_pass = o.clusters_per_pass;
-    ro.cull_back_faces = !o.no_cull;
-    ro.optimize_vertex_cache = !o.no_reorder;
-    ro.count_primitives = ro.mode == render::Mode::kMultipass;
-    if (ro.mode == render::Mode::kUncompressed && o.transfer.empty())
-      throw UsageError("--mode uncompressed needs --transfer PRTX (the raw bake)");
-    if (ro.mode != render::Mode::kUncompressed && !o.transfer.empty())
-      throw UsageError("--transfer is only read by --mode uncompressed");
-    if (ro.mode != render::Mode::kMultipass && ro.mode != render::Mode::kDecoupled &&
-        (cmd->count("--clusters-per-pass") || cmd->count("--strategy")))
-      throw UsageError("--clusters-per-pass and --strategy apply to multipass and decoupled only");
+    const Options& o = *opt;
+    render::RendererOptions ro = renderer_options(o, cmd);
     const render::Background background = resolve_background(o.view);
     const Eigen::Vector3d axis = resolve_axis(o.view);
-
     const cpca::CompressedSet set = cpca::read_compressed(o.compressed);
-    const std::string mesh_path = o.mesh.empty() ? set.mesh_path : o.mesh;
-    if (mesh_path.empty())
-      throw UsageError(o.compressed + " records no mesh path; pass --mesh MESH");
-    const meshes::Mesh mesh = meshes::load_mesh(mesh_path);
-    if (meshes::content_hash(mesh) != set.mesh_hash)
-      throw std::runtime_error(o.compressed + " was baked from a different mesh than " + mesh_path +
-                               " (stale); bake and compress it again, or pass the right --mesh");
-    std::optional<prt::TransferSet> transfer;
-    if (!o.transfer.empty()) {
-      transfer = prt::read_transfer(o.transfer);
-      if (transfer->mesh_hash != set.mesh_hash)
-        throw std::runtime_error(o.transfer + " and " + o.compressed +
-                                 " come from different meshes; use the bake the set was made from");
-    }
+    const meshes::Mesh mesh = load_checked_mesh(o, set);
+    const std::optional<prt::TransferSet> transfer = load_checked_transfer(o, set);
     const probes::Probe probe = probes::load_probe(o.probe);
-    const int order = transfer ? transfer->order : set.order;
-    const prt::ShLighting lighting = prt::project(probe, order);
+    const prt::ShLighting lighting = prt::project(probe, transfer ? transfer->order : set.order);
     const Eigen::Matrix3d rotation = prt::axis_angle(axis, o.rotate_deg * std::numbers::pi / 180.0);
-
     const render::Camera camera = resolve_camera(o.view, mesh);
 
     render::GlContext context;
     if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
       ro.groups = group_for_renderer(mesh, set, context, o.register_budget, o.clusters_per_pass,
                                      o.strategy);
-    std::optional<render::Renderer> renderer;
+    std::unique_ptr<render::Renderer> renderer;
     try {
-      renderer.emplace(mesh, &set, transfer ? &*transfer : nullptr, &probe, ro);
+      renderer = std::make_unique<render::Renderer>(mesh, &set, transfer ? &*transfer : nullptr,
+                                                    &probe, ro);
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
     }
@@ -145,37 +195,12 @@ Runner add_render_command(CLI::App& app) {
     const render::Image image = renderer->read_image();
     render::write_exr(o.output, image);
     if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
-
     const render::RenderStats& st = renderer->stats();
     if (!st.measured_triangles.empty() && st.measured_triangles != st.triangles_per_pass)
       throw std::runtime_error("GL counted " + json_list(st.measured_triangles) +
                                " triangles per pass but the grouping predicts " +
                                json_list(st.triangles_per_pass) + " (a renderer bug)");
-    if (!o.quiet) {
-      std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
-                  o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
-      std::printf(
-          "mode        %s, %d pass(es), %d cluster(s) per pass, budget %d vec4 (%d per cluster)\n",
-          o.mode.c_str(), st.passes, st.clusters_per_pass, st.register_budget,
-          st.registers_per_cluster);
-      std::printf("overdraw    %.4f (%llu triangles, drawn per pass %s)\n", st.average_overdraw,
-                  static_cast<unsigned long long>(st.triangle_count),
-                  json_list(st.triangles_per_pass).c_str());
-      std::printf(
-          "timing      %.2f FPS: frame %.2f ms median (cpu update %.2f ms, gl %.2f ms) over %d "
-          "frames\n",
-          timing.fps, timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median,
-          timing.frames);
-    }
-    if (o.json) {
-      std::printf(
-          "{\"mode\":\"%s\",\"width\":%d,\"height\":%d,\"passes\":%d,\"triangles_per_pass\":%s,"
-          "\"average_overdraw\":%.6f,\"fps\":%.3f,\"frame_ms_median\":%.3f,"
-          "\"cpu_update_ms\":%.3f,\"gl_ms\":%.3f}\n",
-          o.mode.c_str(), o.view.width, o.view.height, st.passes,
-          json_list(st.triangles_per_pass).c_str(), st.average_overdraw, timing.fps,
-          timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median);
-    }
+    print_report(o, st, timing);
   };
 }
 

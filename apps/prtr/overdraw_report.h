@@ -1,4 +1,4 @@
-// apps/prtr/overdraw_report.h: the results of `prtr overdraw` (issue 6) and their four
+// apps/prtr/overdraw_report.h: the results of `prtr overdraw` and their four
 // renderings: Markdown tables in the thesis's column order (tables 5.2-5.17: method,
 // clustering time, average triangle overdraw, FPS, Average SE, then our image RMSE), CSV,
 // JSON, and the plot of overdraw against cluster count.

@@ -21,7 +21,7 @@ std::optional<cpca::SuperClusters> group_for_renderer(const meshes::Mesh& mesh,
   }
   const render::ConstantLayout layout = render::constant_layout(set);
   const int budget =
-      register_budget > 0 ? register_budget : context.info().max_vertex_uniform_vectors;
+      register_budget > 0 ? register_budget : context.info().default_register_budget();
   int per_pass = budget / layout.registers_per_cluster();
   if (clusters_per_pass > 0) per_pass = std::min(per_pass, clusters_per_pass);
   if (per_pass < 1 || strategy == "order") return std::nullopt;

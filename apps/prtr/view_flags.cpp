@@ -1,6 +1,7 @@
 #include "view_flags.h"
 
 #include "commands.h"
+#include "flag_checks.h"
 
 #include <sstream>
 #include <vector>
@@ -17,10 +18,14 @@ void add_view_flags(CLI::App* cmd, ViewFlags& f) {
   cmd->add_option("--eye", f.eye, "Camera position x,y,z (default: frames the bounding sphere)");
   cmd->add_option("--target", f.target, "Camera target x,y,z (default: the sphere's centre)");
   cmd->add_option("--up", f.up, "Camera up x,y,z (default: 0,1,0)");
-  cmd->add_option("--fov", f.fov, "Vertical field of view (degrees)")->capture_default_str();
+  cmd->add_option("--fov", f.fov, "Vertical field of view (degrees)")
+      ->check(finite_number())
+      ->capture_default_str();
   cmd->add_option("--background", f.background, "probe, black, or a colour R,G,B")
       ->capture_default_str();
-  cmd->add_option("--exposure", f.exposure, "PNG exposure in stops")->capture_default_str();
+  cmd->add_option("--exposure", f.exposure, "PNG exposure in stops")
+      ->check(finite_number())
+      ->capture_default_str();
   cmd->add_option("--axis", f.axis, "Environment rotation axis x,y,z")->capture_default_str();
 }
 

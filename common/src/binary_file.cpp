@@ -1,5 +1,7 @@
 #include "common/binary_file.h"
 
+#include "common/hash.h"
+
 #include <cstdio>
 
 namespace common {
@@ -50,6 +52,103 @@ OpenedFile open_binary(const fs::path& path, const std::string& what, const std:
     }
   }
   return f;
+}
+
+namespace {
+constexpr std::size_t kOffMagic = 0;
+constexpr std::size_t kOffVersion = 8;
+constexpr std::size_t kOffHeaderBytes = 12;
+constexpr std::size_t kOffHeaderChecksum = kVersionedHeaderBytes - 8;
+
+// The problem with an open header's identity, or empty.
+std::string identity_problem(const VersionedHeader& h, const VersionedFormat& format) {
+  const std::string remedy = format.remedy;
+  if (std::memcmp(h.data() + kOffMagic, format.magic.data(), format.magic.size()) != 0) {
+    return "not a prtr " + std::string(format.what) + " (it starts with \"" +
+           printable(reinterpret_cast<const char*>(h.data()), format.magic.size()) + "\", not \"" +
+           std::string(format.magic.data(), format.magic.size()) + "\"); name a " + format.file;
+  }
+  const auto version = get_field<std::uint32_t>(h, kOffVersion);
+  if (version != format.version) {
+    const bool newer = version > format.version;
+    return std::string("written by ") + (newer ? "a newer" : "an older") +
+           " prtr version (file format version " + std::to_string(version) +
+           "; this prtr reads version " + std::to_string(format.version) + "); " +
+           (newer ? "use that prtr, or " : "") + remedy + " from this version";
+  }
+  const auto header_bytes = get_field<std::uint32_t>(h, kOffHeaderBytes);
+  if (header_bytes != kVersionedHeaderBytes) {
+    return "header size " + std::to_string(header_bytes) + " bytes, version " +
+           std::to_string(format.version) + " has " + std::to_string(kVersionedHeaderBytes) +
+           "; the header is damaged: " + remedy;
+  }
+  return {};
+}
+}  // namespace
+
+VersionedHeader begin_header(const VersionedFormat& format) {
+  VersionedHeader h{};
+  std::memcpy(h.data() + kOffMagic, format.magic.data(), format.magic.size());
+  put_field<std::uint32_t>(h, kOffVersion, format.version);
+  put_field<std::uint32_t>(h, kOffHeaderBytes, std::uint32_t(kVersionedHeaderBytes));
+  return h;
+}
+
+void seal_header(VersionedHeader& header) {
+  put_field<std::uint64_t>(header, kOffHeaderChecksum, fnv1a(header.data(), kOffHeaderChecksum));
+}
+
+OpenedVersionedFile open_versioned(const fs::path& path, const VersionedFormat& format) {
+  OpenedVersionedFile f;
+  OpenedFile opened =
+      open_binary(path, format.what, std::string("the ") + format.file, format.create);
+  if (!opened.problem.empty()) {
+    f.problem = opened.problem;
+    return f;
+  }
+  f.stream = std::move(opened.stream);
+  f.size = opened.size;
+  const auto truncated = [&](std::uintmax_t found) {
+    return "truncated header: the file has " + std::to_string(found) + " bytes, a " + format.what +
+           " at least " + std::to_string(kVersionedHeaderBytes) + "; " + format.remedy;
+  };
+  if (f.size < kVersionedHeaderBytes) {
+    f.problem = truncated(f.size);
+    return f;
+  }
+  f.stream.read(reinterpret_cast<char*>(f.header.data()), kVersionedHeaderBytes);
+  if (std::size_t(f.stream.gcount()) != kVersionedHeaderBytes) {
+    f.problem = truncated(std::size_t(f.stream.gcount()));
+    return f;
+  }
+  f.problem = identity_problem(f.header, format);
+  return f;
+}
+
+std::string checksum_problem(const char* part, std::uint64_t computed, std::uint64_t recorded,
+                             const VersionedFormat& format) {
+  if (computed == recorded) return {};
+  return std::string(part) + " damaged (checksum " + hex64(computed) + ", the header records " +
+         hex64(recorded) + "); " + format.remedy;
+}
+
+std::string header_checksum_problem(const VersionedHeader& header, const VersionedFormat& format) {
+  return checksum_problem("header", fnv1a(header.data(), kOffHeaderChecksum),
+                          get_field<std::uint64_t>(header, kOffHeaderChecksum), format);
+}
+
+std::string file_size_problem(std::uint64_t expected, std::uintmax_t found,
+                              const VersionedFormat& format) {
+  const std::string remedy = format.remedy;
+  if (found == expected) return {};
+  if (found < expected) {
+    return "truncated: expected " + std::to_string(expected) + " bytes, found " +
+           std::to_string(found) + " (the write or copy was interrupted); copy it again or " +
+           remedy;
+  }
+  return "trailing bytes: expected " + std::to_string(expected) + " bytes, found " +
+         std::to_string(found) + " (" + std::to_string(found - expected) +
+         " extra); the file is damaged: " + remedy;
 }
 
 }  // namespace common

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -59,14 +60,25 @@ DataLayout resolve_layout(const DataLayout& given, Eigen::Index d) {
                                   "the data dimension " + std::to_string(d));
     return given;
   }
+  // A size two layouts share (16: diffuse order 4 or glossy order 2) is refused rather than
+  // guessed: a wrong guess compresses without complaint and renders nonsense.
+  std::vector<DataLayout> matches;
+  std::string names;
   for (int channels : {1, 3})
     for (bool glossy : {false, true})
       for (int order = 1; order <= 10; ++order) {
         const DataLayout l{order, channels, glossy ? order * order : 1};
-        if (size(l) == d) return l;
+        if (size(l) != d) continue;
+        matches.push_back(l);
+        names += std::string(names.empty() ? "" : " or ") + (glossy ? "glossy" : "diffuse") +
+                 " order " + std::to_string(order) + (channels == 3 ? " RGB" : " grey");
       }
-  throw std::invalid_argument("compress: data dimension " + std::to_string(d) +
-                              " is not the size of an SH transfer vector or matrix");
+  if (matches.size() == 1) return matches.front();
+  if (matches.empty())
+    throw std::invalid_argument("compress: data dimension " + std::to_string(d) +
+                                " is not the size of an SH transfer vector or matrix");
+  throw std::invalid_argument("compress: data dimension " + std::to_string(d) + " fits " + names +
+                              "; set CompressOptions::layout to say which");
 }
 
 }  // namespace
@@ -93,42 +105,29 @@ ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data, const Compr
   return error_metrics(data, reconstruction);
 }
 
-CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
-                       const Geometry* geometry, CompressReport* report,
-                       const CompressProgress& progress) {
-  check(data, options, geometry);
-  CompressReport local;
-  CompressReport& r = report ? *report : local;
-  r = CompressReport{};
-  const auto start = Clock::now();
-  auto notify = [&](const char* stage, double fraction) {
-    if (progress) progress(stage, std::clamp(fraction, 0.0, 1.0));
-  };
+namespace {
 
-  // 1. LBG. Progress: log of the converged ratio against log of the threshold.
-  auto t = Clock::now();
-  std::unique_ptr<GeometryCoherence> coherence;
-  if (options.alpha > 0)
-    coherence =
-        std::make_unique<GeometryCoherence>(*geometry, std::size_t(data.rows()), options.alpha);
+using Notify = std::function<void(const char*, double)>;
+
+// Stage 1, LBG. Progress: log of the converged ratio against log of the threshold.
+LbgResult run_lbg(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                  GeometryCoherence* coherence, const Notify& notify) {
   LbgOptions lbg_options;
   lbg_options.clusters = options.clusters;
   lbg_options.threshold = options.lbg_threshold;
   lbg_options.max_iterations = options.lbg_max_iterations;
   lbg_options.seed = options.seed;
   notify("lbg", 0);
-  LbgResult clustering = lbg(data, lbg_options, coherence.get(), [&](int it, double, double ratio) {
+  return lbg(data, lbg_options, coherence, [&](int it, double, double ratio) {
     const double by_ratio = ratio > 0 && options.lbg_threshold > 0
                                 ? std::log(ratio) / std::log(options.lbg_threshold)
                                 : 1.0;
     notify("lbg", std::max(by_ratio, double(it) / options.lbg_max_iterations));
   });
-  r.lbg_seconds = seconds_since(t);
-  r.lbg_iterations = clustering.iterations;
-  r.splits = clustering.splits;
-  r.lbg_energy = clustering.energy;
+}
 
-  const DataLayout layout = resolve_layout(options.layout, data.cols());
+CompressedSet new_set(const CompressOptions& options, const DataLayout& layout,
+                      std::vector<std::uint32_t> cluster_of) {
   CompressedSet set;
   set.order = layout.order;
   set.channels = layout.channels;
@@ -139,7 +138,86 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
   set.alpha = options.alpha;
   set.overdraw_reduction = options.overdraw_reduction;
   set.seed = options.seed;
-  set.cluster_of = std::move(clustering.cluster_of);
+  set.cluster_of = std::move(cluster_of);
+  return set;
+}
+
+// Stage 3, iterative CPCA: reassign to the best-reconstructing cluster, refit, until the
+// error stops falling; a step that raises it (possible with coherence) is undone.
+void iterate_cpca(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                  GeometryCoherence* coherence, const PowerIterationOptions& power,
+                  CompressedSet& set, std::vector<double>& vertex_error, CompressReport& r,
+                  const Notify& notify) {
+  ClusterPcaStats stats;
+  const Eigen::VectorXf norms = data.rowwise().squaredNorm();
+  double error = sum(vertex_error);
+  r.cpca_error.push_back(error);
+  for (int it = 1; it <= options.cpca_max_iterations && error > 0; ++it) {
+    notify("cpca", double(it - 1) / options.cpca_max_iterations);
+    const DataMatrix d2 = subspace_distances(data, norms, set, options.cpca_candidates);
+    CompressedSet next = set;
+    next.cluster_of =
+        coherence ? coherence->assign(d2, set.cluster_of, std::sqrt(error / double(data.rows())))
+                  : argmin_rows(d2);
+    r.splits += split_empty_clusters(data, next.cluster_of, set.cluster_count);
+    std::vector<double> next_error = fit_cluster_pca(data, next, options.solver, power, &stats);
+    r.power_iterations += stats.power_iterations;
+    const double e = sum(next_error);
+    r.cpca_iterations = it;
+    if (!(e < error)) break;
+    const bool converged = (error - e) / error < options.cpca_threshold;
+    set = std::move(next);
+    vertex_error = std::move(next_error);
+    error = e;
+    r.cpca_error.push_back(error);
+    if (converged) break;
+  }
+}
+
+// The errors, size and triangle span of the final set.
+void measure(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+             const Geometry* geometry, const CompressedSet& set,
+             const std::vector<double>& vertex_error, CompressReport& r) {
+  const double total = sum(vertex_error);
+  const Eigen::VectorXd row_norms = data.rowwise().squaredNorm().cast<double>();
+  const double norm = row_norms.sum();
+  r.error.average_squared_error = total / double(data.rows());
+  r.error.relative_error = norm > 0 ? total / norm : 0.0;
+  r.error.max_squared_error = *std::max_element(vertex_error.begin(), vertex_error.end());
+  r.size = size_metrics(std::uint64_t(data.rows()), std::uint64_t(data.cols()),
+                        std::uint64_t(options.clusters), std::uint64_t(options.components));
+  if (geometry) {
+    r.has_geometry = true;
+    r.span = triangle_span(set.cluster_of, geometry->triangles);
+  }
+}
+
+}  // namespace
+
+CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                       const Geometry* geometry, CompressReport* report,
+                       const CompressProgress& progress) {
+  check(data, options, geometry);
+  CompressReport local;
+  CompressReport& r = report ? *report : local;
+  r = CompressReport{};
+  const auto start = Clock::now();
+  const Notify notify = [&](const char* stage, double fraction) {
+    if (progress) progress(stage, std::clamp(fraction, 0.0, 1.0));
+  };
+
+  auto t = Clock::now();
+  std::unique_ptr<GeometryCoherence> coherence;
+  if (options.alpha > 0)
+    coherence =
+        std::make_unique<GeometryCoherence>(*geometry, std::size_t(data.rows()), options.alpha);
+  LbgResult clustering = run_lbg(data, options, coherence.get(), notify);
+  r.lbg_seconds = seconds_since(t);
+  r.lbg_iterations = clustering.iterations;
+  r.splits = clustering.splits;
+  r.lbg_energy = clustering.energy;
+  CompressedSet set = new_set(options, resolve_layout(options.layout, data.cols()),
+                              std::move(clustering.cluster_of));
 
   // 2. PCA per cluster.
   t = Clock::now();
@@ -152,34 +230,10 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
   r.pca_seconds = seconds_since(t);
   notify("pca", 1);
 
-  // 3. Iterative CPCA: reassign to the best-reconstructing cluster, refit, until the error
-  // stops falling; a step that raises it (possible with coherence) is undone.
   int iterations = clustering.iterations;
   if (options.method == ClusterMethod::kIterative) {
     t = Clock::now();
-    const Eigen::VectorXf norms = data.rowwise().squaredNorm();
-    double error = sum(vertex_error);
-    r.cpca_error.push_back(error);
-    for (int it = 1; it <= options.cpca_max_iterations && error > 0; ++it) {
-      notify("cpca", double(it - 1) / options.cpca_max_iterations);
-      const DataMatrix d2 = subspace_distances(data, norms, set, options.cpca_candidates);
-      CompressedSet next = set;
-      next.cluster_of =
-          coherence ? coherence->assign(d2, set.cluster_of, std::sqrt(error / double(data.rows())))
-                    : argmin_rows(d2);
-      r.splits += split_empty_clusters(data, next.cluster_of, set.cluster_count);
-      std::vector<double> next_error = fit_cluster_pca(data, next, options.solver, power, &stats);
-      r.power_iterations += stats.power_iterations;
-      const double e = sum(next_error);
-      r.cpca_iterations = it;
-      if (!(e < error)) break;
-      const bool converged = (error - e) / error < options.cpca_threshold;
-      set = std::move(next);
-      vertex_error = std::move(next_error);
-      error = e;
-      r.cpca_error.push_back(error);
-      if (converged) break;
-    }
+    iterate_cpca(data, options, coherence.get(), power, set, vertex_error, r, notify);
     iterations += r.cpca_iterations;
     r.cpca_seconds = seconds_since(t);
     notify("cpca", 1);
@@ -196,19 +250,7 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
     notify("overdraw", 1);
   }
   set.iterations = iterations;
-
-  const double total = sum(vertex_error);
-  const Eigen::VectorXd row_norms = data.rowwise().squaredNorm().cast<double>();
-  const double norm = row_norms.sum();
-  r.error.average_squared_error = total / double(data.rows());
-  r.error.relative_error = norm > 0 ? total / norm : 0.0;
-  r.error.max_squared_error = *std::max_element(vertex_error.begin(), vertex_error.end());
-  r.size = size_metrics(std::uint64_t(data.rows()), std::uint64_t(data.cols()),
-                        std::uint64_t(options.clusters), std::uint64_t(options.components));
-  if (geometry) {
-    r.has_geometry = true;
-    r.span = triangle_span(set.cluster_of, geometry->triangles);
-  }
+  measure(data, options, geometry, set, vertex_error, r);
   r.total_seconds = seconds_since(start);
   return set;
 }

@@ -72,7 +72,14 @@ constexpr std::uint64_t kMaxVertexCount = std::uint64_t(1) << 40;
 
 constexpr const char* kRecompress = "compress it again with prtr compress";
 
-using Header = std::array<unsigned char, kHeaderBytes>;
+using Header = common::VersionedHeader;
+static_assert(kHeaderBytes == common::kVersionedHeaderBytes);
+constexpr common::VersionedFormat kFormat{"compressed file",
+                                          ".prtc file written by prtr compress",
+                                          "create it with prtr compress",
+                                          kRecompress,
+                                          kMagic,
+                                          kCompressedFileVersion};
 
 std::string num(double v) {
   char buf[48];
@@ -256,10 +263,7 @@ std::string value_problem(const CompressedSet& set) {
 }
 
 Header encode_header(const CompressedSet& set, const Sizes& sizes) {
-  Header h{};
-  std::memcpy(h.data() + kOffMagic, kMagic.data(), kMagic.size());
-  common::put_field<std::uint32_t>(h, kOffVersion, kCompressedFileVersion);
-  common::put_field<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
+  Header h = common::begin_header(kFormat);
   common::put_field<std::uint32_t>(h, kOffOrder, std::uint32_t(set.order));
   common::put_field<std::uint32_t>(h, kOffChannels, std::uint32_t(set.channels));
   common::put_field<std::uint32_t>(h, kOffColumns, std::uint32_t(set.columns));
@@ -279,53 +283,11 @@ Header encode_header(const CompressedSet& set, const Sizes& sizes) {
   common::put_field<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum_of(set));
   common::put_field<std::uint64_t>(h, kOffMeshPathChecksum,
                                    common::fnv1a(set.mesh_path.data(), set.mesh_path.size()));
-  common::put_field<std::uint64_t>(h, kOffHeaderChecksum,
-                                   common::fnv1a(h.data(), kOffHeaderChecksum));
+  common::seal_header(h);
   return h;
 }
 
-CompressedSet read(const fs::path& path, bool with_payload) {
-  const std::string name = path.string();
-  const auto fail = [&](const std::string& problem) {
-    return CompressedFileError(name + ": " + problem);
-  };
-
-  common::OpenedFile opened =
-      common::open_binary(path, "compressed file", "the .prtc file written by prtr compress",
-                          "create it with prtr compress");
-  if (!opened.problem.empty()) throw fail(opened.problem);
-  std::ifstream& in = opened.stream;
-  const std::uintmax_t size = opened.size;
-
-  const auto truncated_header = [&](std::uintmax_t found) {
-    return fail("truncated header: the file has " + std::to_string(found) +
-                " bytes, a compressed file at least " + std::to_string(kHeaderBytes) + "; " +
-                kRecompress);
-  };
-  if (size < kHeaderBytes) throw truncated_header(size);
-  Header h;
-  in.read(reinterpret_cast<char*>(h.data()), kHeaderBytes);
-  if (std::size_t(in.gcount()) != kHeaderBytes) throw truncated_header(std::size_t(in.gcount()));
-
-  if (std::memcmp(h.data() + kOffMagic, kMagic.data(), kMagic.size()) != 0) {
-    throw fail("not a prtr compressed file (it starts with \"" +
-               common::printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
-               "\", not \"PRTRCMPR\"); name a .prtc file written by prtr compress");
-  }
-  const auto version = common::get_field<std::uint32_t>(h, kOffVersion);
-  if (version != kCompressedFileVersion) {
-    const bool newer = version > kCompressedFileVersion;
-    throw fail(std::string("written by ") + (newer ? "a newer" : "an older") +
-               " prtr version (file format version " + std::to_string(version) +
-               "; this prtr reads version " + std::to_string(kCompressedFileVersion) + "); " +
-               (newer ? "use that prtr, or " : "") + kRecompress + " from this version");
-  }
-  const auto header_bytes = common::get_field<std::uint32_t>(h, kOffHeaderBytes);
-  if (header_bytes != kHeaderBytes) {
-    throw fail("header size " + std::to_string(header_bytes) + " bytes, version 1 has " +
-               std::to_string(kHeaderBytes) + "; the header is damaged: " + kRecompress);
-  }
-
+Fields decode_fields(const Header& h) {
   Fields f;
   f.order = common::get_field<std::uint32_t>(h, kOffOrder);
   f.channels = common::get_field<std::uint32_t>(h, kOffChannels);
@@ -339,45 +301,11 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   f.mesh_path_bytes = common::get_field<std::uint32_t>(h, kOffMeshPathBytes);
   f.vertex_count = common::get_field<std::uint64_t>(h, kOffVertexCount);
   f.alpha = common::get_field<double>(h, kOffAlpha);
-  if (const std::string problem = field_problem(f); !problem.empty()) {
-    throw fail(problem + " in the header; the file is damaged: " + kRecompress);
-  }
+  return f;
+}
 
-  Sizes sizes;
-  const std::uint64_t payload_bytes = common::get_field<std::uint64_t>(h, kOffPayloadBytes);
-  if (!sizes_of(f, &sizes) || payload_bytes != sizes.payload_bytes) {
-    throw fail("payload size mismatch: the header says " + std::to_string(payload_bytes) +
-               " bytes, but " + std::to_string(f.vertex_count) + " vertices, " +
-               std::to_string(f.clusters) + " clusters and " + std::to_string(f.components) +
-               " components need " + std::to_string(sizes.payload_bytes) +
-               "; the header is damaged: " + kRecompress);
-  }
-  const auto header_checksum = common::fnv1a(h.data(), kOffHeaderChecksum);
-  if (header_checksum != common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) {
-    throw fail("header damaged (checksum " + common::hex64(header_checksum) +
-               ", the header records " +
-               common::hex64(common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) + "); " +
-               kRecompress);
-  }
-  const std::size_t path_block = padded(f.mesh_path_bytes);
-  std::uint64_t expected_size = 0;
-  if (__builtin_add_overflow(payload_bytes, std::uint64_t(kHeaderBytes + path_block),
-                             &expected_size)) {
-    throw fail("payload of " + std::to_string(payload_bytes) +
-               " bytes is too large for any file; the header is damaged: " + kRecompress);
-  }
-  const auto size_problem = [&](std::uintmax_t found) {
-    if (found < expected_size) {
-      return fail("truncated: expected " + std::to_string(expected_size) + " bytes, found " +
-                  std::to_string(found) +
-                  " (the write or copy was interrupted); copy it again or " + kRecompress);
-    }
-    return fail("trailing bytes: expected " + std::to_string(expected_size) + " bytes, found " +
-                std::to_string(found) + " (" + std::to_string(found - expected_size) +
-                " extra); the file is damaged: " + kRecompress);
-  };
-  if (size != expected_size) throw size_problem(size);
-
+// The set's header fields (checked fields `f`; the hashes straight from the header).
+CompressedSet set_from(const Fields& f, const Header& h) {
   CompressedSet set;
   set.order = int(f.order);
   set.channels = int(f.channels);
@@ -393,6 +321,66 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   set.seed = common::get_field<std::uint64_t>(h, kOffSeed);
   set.mesh_hash = common::get_field<std::uint64_t>(h, kOffMeshHash);
   set.transfer_hash = common::get_field<std::uint64_t>(h, kOffTransferHash);
+  return set;
+}
+
+// The mesh path block (path, then zero padding) against its checksum, or empty.
+std::string mesh_path_problem(const std::string& block, const Fields& f, const Header& h) {
+  const std::string path = block.substr(0, f.mesh_path_bytes);
+  if (std::string problem = common::checksum_problem(
+          "mesh path", common::fnv1a(path.data(), path.size()),
+          common::get_field<std::uint64_t>(h, kOffMeshPathChecksum), kFormat);
+      !problem.empty())
+    return problem;
+  if (const std::size_t i = first_bad_utf8(path); i != path.size())
+    return "mesh path is not UTF-8 (byte " + std::to_string(i) +
+           "); the file is damaged: " + kRecompress;
+  if (block.find_first_not_of('\0', f.mesh_path_bytes) != std::string::npos)
+    return "mesh path padding is not zero; the file is damaged: " + std::string(kRecompress);
+  return {};
+}
+
+CompressedSet read(const fs::path& path, bool with_payload) {
+  const std::string name = path.string();
+  const auto fail = [&](const std::string& problem) {
+    return CompressedFileError(name + ": " + problem);
+  };
+
+  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
+  if (!opened.problem.empty()) throw fail(opened.problem);
+  std::ifstream& in = opened.stream;
+  const std::uintmax_t size = opened.size;
+  const Header& h = opened.header;
+
+  const Fields f = decode_fields(h);
+  if (const std::string problem = field_problem(f); !problem.empty()) {
+    throw fail(problem + " in the header; the file is damaged: " + kRecompress);
+  }
+
+  Sizes sizes;
+  const std::uint64_t payload_bytes = common::get_field<std::uint64_t>(h, kOffPayloadBytes);
+  if (!sizes_of(f, &sizes) || payload_bytes != sizes.payload_bytes) {
+    throw fail("payload size mismatch: the header says " + std::to_string(payload_bytes) +
+               " bytes, but " + std::to_string(f.vertex_count) + " vertices, " +
+               std::to_string(f.clusters) + " clusters and " + std::to_string(f.components) +
+               " components need " + std::to_string(sizes.payload_bytes) +
+               "; the header is damaged: " + kRecompress);
+  }
+  if (const std::string problem = common::header_checksum_problem(h, kFormat); !problem.empty())
+    throw fail(problem);
+  const std::size_t path_block = padded(f.mesh_path_bytes);
+  std::uint64_t expected_size = 0;
+  if (__builtin_add_overflow(payload_bytes, std::uint64_t(kHeaderBytes + path_block),
+                             &expected_size)) {
+    throw fail("payload of " + std::to_string(payload_bytes) +
+               " bytes is too large for any file; the header is damaged: " + kRecompress);
+  }
+  const auto size_problem = [&](std::uintmax_t found) {
+    return fail(common::file_size_problem(expected_size, found, kFormat));
+  };
+  if (size != expected_size) throw size_problem(size);
+
+  CompressedSet set = set_from(f, h);
 
   // The file size was checked, so a short read below means the file changed under us.
   std::size_t offset = kHeaderBytes;
@@ -404,20 +392,8 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   std::string block(path_block, '\0');
   read_into(block.data(), path_block);
   set.mesh_path = block.substr(0, f.mesh_path_bytes);
-  const auto path_checksum = common::fnv1a(set.mesh_path.data(), set.mesh_path.size());
-  if (path_checksum != common::get_field<std::uint64_t>(h, kOffMeshPathChecksum)) {
-    throw fail("mesh path damaged (checksum " + common::hex64(path_checksum) +
-               ", the header records " +
-               common::hex64(common::get_field<std::uint64_t>(h, kOffMeshPathChecksum)) + "); " +
-               kRecompress);
-  }
-  if (const std::size_t i = first_bad_utf8(set.mesh_path); i != set.mesh_path.size()) {
-    throw fail("mesh path is not UTF-8 (byte " + std::to_string(i) +
-               "); the file is damaged: " + kRecompress);
-  }
-  if (block.find_first_not_of('\0', f.mesh_path_bytes) != std::string::npos) {
-    throw fail("mesh path padding is not zero; the file is damaged: " + std::string(kRecompress));
-  }
+  if (const std::string problem = mesh_path_problem(block, f, h); !problem.empty())
+    throw fail(problem);
   if (!with_payload) return set;
 
   set.cluster_of.resize(sizes.ids);
@@ -428,13 +404,11 @@ CompressedSet read(const fs::path& path, bool with_payload) {
   read_into(set.weights.data(), sizes.weights * 4);
   read_into(set.means.data(), sizes.means * 4);
   read_into(set.bases.data(), sizes.bases * 4);
-  const auto payload_checksum = payload_checksum_of(set);
-  if (payload_checksum != common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) {
-    throw fail("payload damaged (checksum " + common::hex64(payload_checksum) +
-               ", the header records " +
-               common::hex64(common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) + "); " +
-               kRecompress);
-  }
+  if (const std::string problem = common::checksum_problem(
+          "payload", payload_checksum_of(set),
+          common::get_field<std::uint64_t>(h, kOffPayloadChecksum), kFormat);
+      !problem.empty())
+    throw fail(problem);
   if (const std::string problem = value_problem(set); !problem.empty()) {
     throw fail(problem + "; the file is damaged: " + kRecompress);
   }

@@ -8,6 +8,30 @@
 #include <string>
 
 namespace cpca {
+namespace {
+
+// Vertex -> incident triangles, CSR: vertex p's triangles are incident[start[p] .. start[p+1]).
+struct Incidence {
+  std::vector<std::uint32_t> start, incident;
+};
+
+Incidence incident_triangles(const Geometry& geometry, std::size_t v) {
+  Incidence c;
+  c.start.assign(v + 1, 0);
+  for (const TriangleIndices& t : geometry.triangles)
+    for (std::uint32_t i : t) {
+      if (i >= v) throw std::invalid_argument("overdraw reduction: triangle index out of range");
+      ++c.start[i + 1];
+    }
+  std::partial_sum(c.start.begin(), c.start.end(), c.start.begin());
+  c.incident.resize(c.start[v]);
+  std::vector<std::uint32_t> fill(c.start.begin(), c.start.end() - 1);
+  for (std::size_t t = 0; t < geometry.triangles.size(); ++t)
+    for (std::uint32_t i : geometry.triangles[t]) c.incident[fill[i]++] = std::uint32_t(t);
+  return c;
+}
+
+}  // namespace
 
 OverdrawReductionResult reduce_overdraw(const Eigen::Ref<const DataMatrix>& x,
                                         const Geometry& geometry, CompressedSet& set,
@@ -20,20 +44,9 @@ OverdrawReductionResult reduce_overdraw(const Eigen::Ref<const DataMatrix>& x,
                                 " vertices but the data has " + std::to_string(v) + " rows");
   if (!(options.tolerance >= 0))
     throw std::invalid_argument("overdraw reduction: tolerance must be >= 0");
-  // Vertex -> incident triangles (CSR).
-  std::vector<std::uint32_t> start(v + 1, 0), incident;
-  for (const TriangleIndices& t : geometry.triangles)
-    for (std::uint32_t i : t) {
-      if (i >= v) throw std::invalid_argument("overdraw reduction: triangle index out of range");
-      ++start[i + 1];
-    }
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  incident.resize(start[v]);
-  {
-    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t t = 0; t < geometry.triangles.size(); ++t)
-      for (std::uint32_t i : geometry.triangles[t]) incident[fill[i]++] = std::uint32_t(t);
-  }
+  const Incidence incidence = incident_triangles(geometry, v);
+  const std::vector<std::uint32_t>& start = incidence.start;
+  const std::vector<std::uint32_t>& incident = incidence.incident;
   std::vector<std::uint32_t>& cluster = set.cluster_of;
   std::vector<std::size_t> count(std::size_t(set.cluster_count), 0);
   for (std::uint32_t c : cluster) ++count[c];

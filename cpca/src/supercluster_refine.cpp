@@ -1,5 +1,5 @@
 // Exact local search on super-cluster groupings (moves and pairwise swaps); the refinement
-// stage the issue asks for after the partitioner, also applied to greedy's result.
+// stage that follows the partitioner, also applied to greedy's result.
 #include "cpca/supercluster_refine.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Reflectance models and their SH BRDF matrices (DESIGN.md, "The math"; the thesis's glossy
+// Reflectance models and their SH BRDF matrices (thesis ch. 3.1.1 and its glossy
 // materials). Models: Lambert; the energy-normalised "modified Phong" of Lafortune & Willems,
 // "Using the modified Phong reflectance model for physically based rendering" (1994);
 // Cook & Torrance, "A reflectance model for computer graphics" (ACM TOG 1, 1982) with the

@@ -71,7 +71,14 @@ constexpr float kMaxExponent = 10000.f;
 
 constexpr const char* kRebake = "bake it again with prtr bake";
 
-using Header = std::array<unsigned char, kHeaderBytes>;
+using Header = common::VersionedHeader;
+static_assert(kHeaderBytes == common::kVersionedHeaderBytes);
+constexpr common::VersionedFormat kFormat{"transfer file",
+                                          ".prtx file written by prtr bake",
+                                          "create it with prtr bake",
+                                          kRebake,
+                                          kMagic,
+                                          kTransferFileVersion};
 
 std::string num(float v) {
   char buf[48];
@@ -176,10 +183,7 @@ std::size_t first_non_finite(const std::vector<float>& data) {
 }
 
 Header encode_header(const TransferSet& set, std::uint64_t payload_checksum) {
-  Header h{};  // zero: padding and reserved fields
-  std::memcpy(h.data() + kOffMagic, kMagic.data(), kMagic.size());
-  common::put_field<std::uint32_t>(h, kOffVersion, kTransferFileVersion);
-  common::put_field<std::uint32_t>(h, kOffHeaderBytes, kHeaderBytes);
+  Header h = common::begin_header(kFormat);  // zero: padding and reserved fields
   common::put_field<std::uint32_t>(h, kOffKind, static_cast<std::uint32_t>(set.kind));
   common::put_field<std::uint32_t>(h, kOffOrder, static_cast<std::uint32_t>(set.order));
   common::put_field<std::uint32_t>(h, kOffChannels, static_cast<std::uint32_t>(set.channels));
@@ -198,8 +202,7 @@ Header encode_header(const TransferSet& set, std::uint64_t payload_checksum) {
   common::put_field<float>(h, kOffF0, set.material.f0);
   common::put_field<std::uint64_t>(h, kOffPayloadFloats, set.data.size());
   common::put_field<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum);
-  common::put_field<std::uint64_t>(h, kOffHeaderChecksum,
-                                   common::fnv1a(h.data(), kOffHeaderChecksum));
+  common::seal_header(h);
   return h;
 }
 
@@ -208,43 +211,11 @@ TransferSet read(const fs::path& path, bool with_payload) {
   const auto fail = [&](const std::string& problem) {
     return TransferFileError(name + ": " + problem);
   };
-
-  common::OpenedFile opened = common::open_binary(
-      path, "transfer file", "the .prtx file written by prtr bake", "create it with prtr bake");
+  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
   if (!opened.problem.empty()) throw fail(opened.problem);
   std::ifstream& in = opened.stream;
   const std::uintmax_t size = opened.size;
-
-  const auto truncated_header = [&](std::uintmax_t found) {
-    return fail("truncated header: the file has " + std::to_string(found) +
-                " bytes, a transfer file at least " + std::to_string(kHeaderBytes) + "; " +
-                kRebake);
-  };
-  if (size < kHeaderBytes) throw truncated_header(size);
-  Header h;
-  in.read(reinterpret_cast<char*>(h.data()), kHeaderBytes);
-  if (std::size_t(in.gcount()) != kHeaderBytes) throw truncated_header(std::size_t(in.gcount()));
-
-  // Identity and version before any field is trusted.
-  if (std::memcmp(h.data() + kOffMagic, kMagic.data(), kMagic.size()) != 0) {
-    throw fail("not a prtr transfer file (it starts with \"" +
-               common::printable(reinterpret_cast<const char*>(h.data()), kMagic.size()) +
-               "\", not \"PRTRXFER\"); name a .prtx file written by prtr bake");
-  }
-  const auto version = common::get_field<std::uint32_t>(h, kOffVersion);
-  if (version != kTransferFileVersion) {
-    const std::string which = version > kTransferFileVersion ? "a newer" : "an older";
-    throw fail("written by " + which + " prtr version (file format version " +
-               std::to_string(version) + "; this prtr reads version " +
-               std::to_string(kTransferFileVersion) + "); " +
-               (version > kTransferFileVersion ? "use that prtr, or " : "") + kRebake +
-               " from this version");
-  }
-  const auto header_bytes = common::get_field<std::uint32_t>(h, kOffHeaderBytes);
-  if (header_bytes != kHeaderBytes) {
-    throw fail("header size " + std::to_string(header_bytes) + " bytes, version 1 has " +
-               std::to_string(kHeaderBytes) + "; the header is damaged: " + kRebake);
-  }
+  const Header& h = opened.header;
 
   Fields f;
   f.kind = common::get_field<std::uint32_t>(h, kOffKind);
@@ -295,12 +266,8 @@ TransferSet read(const fs::path& path, bool with_payload) {
                std::to_string(set.floats_per_vertex()) + " floats per vertex is " +
                std::to_string(expected_floats) + "; the header is damaged: " + kRebake);
   }
-  const auto header_checksum = common::fnv1a(h.data(), kOffHeaderChecksum);
-  if (header_checksum != common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) {
-    throw fail(
-        "header damaged (checksum " + common::hex64(header_checksum) + ", the header records " +
-        common::hex64(common::get_field<std::uint64_t>(h, kOffHeaderChecksum)) + "); " + kRebake);
-  }
+  if (const std::string problem = common::header_checksum_problem(h, kFormat); !problem.empty())
+    throw fail(problem);
   std::uint64_t expected_size = 0;
   if (__builtin_mul_overflow(payload_floats, std::uint64_t(4), &expected_size) ||
       __builtin_add_overflow(expected_size, std::uint64_t(kHeaderBytes), &expected_size)) {
@@ -308,14 +275,7 @@ TransferSet read(const fs::path& path, bool with_payload) {
                " floats is too large for any file; the header is damaged: " + kRebake);
   }
   const auto size_problem = [&](std::uintmax_t found) {
-    if (found < expected_size) {
-      return fail("truncated: expected " + std::to_string(expected_size) + " bytes, found " +
-                  std::to_string(found) +
-                  " (the write or copy was interrupted); copy it again or " + kRebake);
-    }
-    return fail("trailing bytes: expected " + std::to_string(expected_size) + " bytes, found " +
-                std::to_string(found) + " (" + std::to_string(found - expected_size) +
-                " extra); the file is damaged: " + kRebake);
+    return fail(common::file_size_problem(expected_size, found, kFormat));
   };
   if (size != expected_size) throw size_problem(size);
   if (!with_payload) return set;
@@ -328,12 +288,11 @@ TransferSet read(const fs::path& path, bool with_payload) {
   if (std::size_t(in.gcount()) != payload_bytes) {
     throw size_problem(kHeaderBytes + std::size_t(in.gcount()));
   }
-  const auto payload_checksum = common::fnv1a(set.data.data(), payload_bytes);
-  if (payload_checksum != common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) {
-    throw fail(
-        "payload damaged (checksum " + common::hex64(payload_checksum) + ", the header records " +
-        common::hex64(common::get_field<std::uint64_t>(h, kOffPayloadChecksum)) + "); " + kRebake);
-  }
+  if (const std::string problem = common::checksum_problem(
+          "payload", common::fnv1a(set.data.data(), payload_bytes),
+          common::get_field<std::uint64_t>(h, kOffPayloadChecksum), kFormat);
+      !problem.empty())
+    throw fail(problem);
   if (const std::size_t i = first_non_finite(set.data); i != set.data.size()) {
     throw fail("non-finite value " + num(set.data[i]) + " at " + locate(set, i) +
                "; the file is damaged: " + kRebake);

@@ -1,6 +1,8 @@
 #include "render/floor_harness.h"
 
+#include "frame_target.h"
 #include "gl_program.h"
+#include "median.h"
 #include "render/gl_context.h"
 #include "render/shader_source.h"
 
@@ -23,7 +25,7 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
                                 mesh.vertex_count());
     indices.swap(optimised);
   }
-  GLuint vao = 0, vbo = 0, ibo = 0, fbo = 0, rb[2] = {0, 0};
+  GLuint vao = 0, vbo = 0, ibo = 0;
   glGenVertexArrays(1, &vao);
   glBindVertexArray(vao);
   glGenBuffers(1, &vbo);
@@ -36,21 +38,13 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
   glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * 4), indices.data(),
                GL_STATIC_DRAW);
-  glGenFramebuffers(1, &fbo);
-  glGenRenderbuffers(2, rb);
-  glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, camera.width, camera.height);
-  glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, camera.width, camera.height);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+  FrameTarget target;  // the renderer's framebuffer, so the floor measures the same target
+  target.bind(camera.width, camera.height);
   GlProgram program("floor", position_vertex_shader(), constant_fragment_shader());
   program.use();
   const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
   glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
   glUniform3f(program.uniform("u_colour"), 0.5f, 0.5f, 0.5f);
-  glViewport(0, 0, camera.width, camera.height);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_BLEND);
@@ -75,14 +69,10 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
   check_gl("floor_frame_ms");
   glDisable(GL_CULL_FACE);
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-  glDeleteFramebuffers(1, &fbo);
-  glDeleteRenderbuffers(2, rb);
   glDeleteBuffers(1, &vbo);
   glDeleteBuffers(1, &ibo);
   glDeleteVertexArrays(1, &vao);
-  std::sort(ms.begin(), ms.end());
-  const std::size_t n = ms.size();
-  return n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+  return median(std::move(ms));
 }
 
 }  // namespace render

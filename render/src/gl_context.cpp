@@ -5,6 +5,7 @@
 #include <GL/glext.h>
 #include <GL/osmesa.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -58,7 +59,15 @@ void GlContext::make_current() {
   }
 }
 
+int GlInfo::default_register_budget() const {
+  return std::min(max_vertex_uniform_vectors, max_uniform_block_size / 16);
+}
+
 GlInfo GlContext::info() const {
+  return current_gl_info();
+}
+
+GlInfo current_gl_info() {
   auto str = [](GLenum name) {
     const auto* s = reinterpret_cast<const char*>(glGetString(name));
     return std::string(s ? s : "");

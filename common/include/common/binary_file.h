@@ -48,4 +48,48 @@ struct OpenedFile {
 OpenedFile open_binary(const std::filesystem::path& path, const std::string& what,
                        const std::string& made_by, const std::string& create);
 
+// The skeleton every versioned prtr file shares (docs/FORMATS.md): a 128-byte header with an
+// 8-byte magic at 0, the u32 format version at 8, the u32 header size at 12 and, in its last
+// 8 bytes, the FNV-1a checksum of the bytes before them. One owner for the checks and their
+// wording, so .prtx and .prtc refuse a bad file in the same words.
+inline constexpr std::size_t kVersionedHeaderBytes = 128;
+using VersionedHeader = std::array<unsigned char, kVersionedHeaderBytes>;
+
+struct VersionedFormat {
+  const char* what;    // "transfer file"
+  const char* file;    // ".prtx file written by prtr bake"
+  const char* create;  // "create it with prtr bake"
+  const char* remedy;  // "bake it again with prtr bake"
+  std::array<char, 8> magic;
+  std::uint32_t version;
+};
+
+// Zero bytes but the magic, version and header size; the format fills its own fields.
+VersionedHeader begin_header(const VersionedFormat& format);
+// Writes the header checksum; the last step before the header goes to disk.
+void seal_header(VersionedHeader& header);
+
+// The open file with its header read, or the problem (as for open_binary) with the format's
+// remedy: not found, truncated header, wrong magic, other version, wrong header size. The
+// format's own fields are not looked at; the header checksum is checked by
+// header_checksum_problem once the caller has checked its fields, so that a damaged field is
+// named rather than reported as a bad checksum.
+struct OpenedVersionedFile {
+  std::ifstream stream;
+  std::uintmax_t size = 0;
+  VersionedHeader header{};
+  std::string problem;
+};
+OpenedVersionedFile open_versioned(const std::filesystem::path& path,
+                                   const VersionedFormat& format);
+
+// Empty when the recorded header checksum matches.
+std::string header_checksum_problem(const VersionedHeader& header, const VersionedFormat& format);
+// "<part> damaged (checksum X, the header records Y); <remedy>", or empty when they match.
+std::string checksum_problem(const char* part, std::uint64_t computed, std::uint64_t recorded,
+                             const VersionedFormat& format);
+// Truncated or trailing bytes, or empty when `found` is `expected`.
+std::string file_size_problem(std::uint64_t expected, std::uintmax_t found,
+                              const VersionedFormat& format);
+
 }  // namespace common

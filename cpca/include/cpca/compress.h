@@ -15,9 +15,10 @@
 
 namespace cpca {
 
-// The layout of a data row (compressed.h). Order 0 means "infer from the dimension": the
-// first of diffuse grey (n), glossy grey (n^2), diffuse RGB (3n), glossy RGB (3n^2) whose size
-// matches, for order 1..10.
+// The layout of a data row (compressed.h). Order 0 means "infer from the dimension": the one
+// of diffuse grey (n), glossy grey (n^2), diffuse RGB (3n), glossy RGB (3n^2), order 1..10,
+// whose size matches. Sizes two layouts share (1, 3, 16, 48, 81, 243) are refused
+// (std::invalid_argument): callers that know the layout should always pass it.
 struct DataLayout {
   int order = 0;
   int channels = 1;

@@ -1,5 +1,5 @@
 // cpca/compressed.h: a clustered-PCA compressed transfer set, in memory (thesis eq. 6,
-// DESIGN.md "CPCA"). This is what the renderer consumes.
+// docs/ARCHITECTURE.md "Compression"). This is what the renderer consumes.
 //
 // The data compressed is one row per vertex, x_p = vec(M_p) over all channels, in the
 // layout of prt::TransferSet: channel-major, then the row-major n x cols matrix
@@ -24,12 +24,17 @@ enum class ClusterMethod : std::uint32_t {
   kIterative = 1,  // Sloan et al. 2003 iterative CPCA: reassign by reconstruction error
 };
 const char* cluster_method_name(ClusterMethod method);  // "lbg", "iterative"
+// Throws std::invalid_argument listing the names.
+ClusterMethod parse_cluster_method(const std::string& name);
+std::vector<std::string> cluster_method_names();
 
 enum class PcaSolver : std::uint32_t {
   kPowerIteration = 0,  // SLF paper Algorithm 1 (default)
   kEigen = 1,           // Eigen's SelfAdjointEigenSolver
 };
 const char* pca_solver_name(PcaSolver solver);  // "power", "eigen"
+PcaSolver parse_pca_solver(const std::string& name);
+std::vector<std::string> pca_solver_names();
 
 struct CompressedSet {
   // Layout of the source transfer (copied from the bake).

@@ -1,5 +1,5 @@
 // cpca/metrics.h: error and size measures of a compressed transfer set (thesis ch. 3.1.3
-// and the result tables 5.2-5.17; DESIGN.md "CPCA").
+// and the result tables 5.2-5.17; docs/ARCHITECTURE.md "Compression").
 //
 // Data is a V x D matrix, one row per vertex (x_p = vec(M_p), all channels concatenated);
 // the reconstruction has the same shape.

@@ -1,6 +1,6 @@
 // cpca/supercluster.h: grouping clusters into super-clusters, one per render pass, and the
-// triangle overdraw that a grouping causes (thesis ch. 4.1, eq. 8; DESIGN.md "Rendering,
-// super-clusters, overdraw").
+// triangle overdraw that a grouping causes (thesis ch. 4.1, eq. 8; docs/ARCHITECTURE.md
+// "Rendering", multipass).
 //
 // A pass holds the constants of its clusters within a register budget (vec4 count). A
 // triangle is drawn in every pass that holds the cluster of at least one of its vertices,

@@ -1,5 +1,6 @@
 // cpca/supercluster_metis.h: super-clusters from a graph partitioner (METIS 5, k-way) on the
-// cluster-adjacency graph weighted by shared triangles (issue 6, strategy 3).
+// cluster-adjacency graph weighted by shared triangles (one of the strategies
+// prtr overdraw compares).
 //
 // Parts = ceil(K / per_pass), unit vertex weights. METIS balances only approximately, so
 // overfull parts are repaired by moving, one at a time, the cluster whose move to a part with

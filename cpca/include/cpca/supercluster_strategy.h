@@ -1,5 +1,6 @@
 // cpca/supercluster_strategy.h: one interface for super-cluster strategies and a registry of
-// them by name, so the CLI and the benchmark can loop over all of them (issue 6).
+// them by name, so the CLI and the benchmark can loop over all of them
+// (prtr overdraw compares them; thesis ch. 4.3).
 //
 // A strategy groups `cluster_count` clusters into passes of at most `per_pass` clusters,
 // every cluster in exactly one pass, trying to keep the exact triangle overdraw low

@@ -11,7 +11,7 @@
 // rho_d is RGB; when its three channels are equal the material is grey and transfer needs one
 // channel, otherwise three (rho_s, e, m and f0 are the same for all channels).
 //
-// BRDF matrix (DESIGN.md, "The math"), for one channel:
+// BRDF matrix (thesis ch. 3.1.1), for one channel:
 //     B_ij = int_{v.z>0} int_{s.z>0} y_i(v) f_r(v, s) s.z y_j(s) ds dv
 // so that exit radiance toward local v is y(v)^T B l_local for local incident lighting l_local.
 #pragma once

@@ -1,4 +1,5 @@
-// render/false_colour.h: flat false-colour pictures of a mesh (issue 6): the overdraw picture
+// render/false_colour.h: flat false-colour pictures of a mesh (for prtr overdraw): the overdraw
+// picture
 // (each triangle coloured by how many passes draw it: 1, 2, 3+, with a legend drawn into the
 // image) and the cluster picture (one colour per cluster), plus the small 2D drawing kit the
 // legend and the benchmark's plot use.

@@ -1,4 +1,5 @@
-// render/floor_harness.h: the llvmpipe floor of issue 5's benchmark. Draws a mesh with a
+// render/floor_harness.h: the llvmpipe floor of the render benchmark
+// (bench/render_bench.cpp). Draws a mesh with a
 // trivial shader (position only, constant colour) into the same RGBA32F + depth framebuffer
 // the renderer uses, so a mode's frame time can be reported as a ratio to what the
 // rasteriser alone costs on this machine.

@@ -14,10 +14,19 @@ struct GlInfo {
   std::string glsl_version;  // GL_SHADING_LANGUAGE_VERSION
   int major = 0, minor = 0;
   bool core_profile = false;
-  int max_vertex_uniform_vectors = 0;  // the register budget's default (vec4 count)
+  int max_vertex_uniform_vectors = 0;  // vec4 count
   int max_uniform_block_size = 0;      // bytes
   long long max_ssbo_size = 0;         // bytes
+
+  // The vec4 registers one pass may bind when no budget is given: a pass's constants are one
+  // UBO range, which must fit both the vertex stage's uniform vectors and one uniform block.
+  // Every default budget (renderer, pass grouping, benchmark) comes from here, so a driver
+  // whose block is the smaller limit cannot make them disagree.
+  int default_register_budget() const;
 };
+
+// The limits of the context current on this thread (GlContext::info of it).
+GlInfo current_gl_info();
 
 class GlError : public std::runtime_error {
  public:

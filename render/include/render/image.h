@@ -1,10 +1,10 @@
 // render/image.h: a float RGBA image and its EXR and PNG writers (OpenImageIO, only in
 // render/src/image.cpp).
 //
-// Pixels are linear radiance in the probe's units (DESIGN.md: tone mapping happens only when
-// writing PNG); alpha is coverage (1 where the mesh is, 0 on the background). Row 0 is the
-// top row. Both writers are atomic: a temporary file in the target's directory, renamed
-// over the target once complete.
+// Pixels are linear radiance in the probe's units (docs/ARCHITECTURE.md "Rendering", Output: tone
+// mapping happens only when writing PNG); alpha is coverage (1 where the mesh is, 0 on the
+// background). Row 0 is the top row. Both writers are atomic: a temporary file in the target's
+// directory, renamed over the target once complete.
 //
 // PNG tone map, documented here once: c = radiance * 2^exposure, then the ACES filmic curve
 // fitted by K. Narkowicz (2015), f(c) = c (2.51 c + 0.03) / (c (2.43 c + 0.59) + 0.14)

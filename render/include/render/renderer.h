@@ -1,6 +1,6 @@
 // render/renderer.h: relights a CPCA-compressed mesh with OpenGL (OSMesa/llvmpipe) into an
-// offscreen RGBA32F + depth framebuffer. Thesis ch. 3.2 and 4.1; DESIGN.md "Rendering,
-// super-clusters, overdraw"; issue 5.
+// offscreen RGBA32F + depth framebuffer. Thesis ch. 3.2 and 4.1; docs/ARCHITECTURE.md
+// "Rendering".
 //
 // Modes (all give the same image up to float rounding; tests hold them to it):
 //  - multipass:    depth pre-pass, then one additive pass per super-cluster with GL_EQUAL
@@ -46,14 +46,15 @@
 namespace render {
 
 enum class Mode { kMultipass, kSinglepass, kDecoupled, kUncompressed, kCpu };
-const char* mode_name(Mode mode);  // "multipass", ...
+const char* mode_name(Mode mode);  // "multipass", ...; "unknown" out of range
 // Throws std::invalid_argument listing the valid names.
 Mode parse_mode(const std::string& name);
+std::vector<std::string> mode_names();
 
 struct RendererOptions {
   Mode mode = Mode::kMultipass;
-  // vec4 registers a pass may use; 0 = what the context offers (the smaller of
-  // GL_MAX_VERTEX_UNIFORM_VECTORS and GL_MAX_UNIFORM_BLOCK_SIZE / 16).
+  // vec4 registers a pass may use; 0 = what the context offers
+  // (GlInfo::default_register_budget).
   int register_budget = 0;
   // Clusters per pass; 0 = as many as the budget holds. More than the budget holds is an error.
   int clusters_per_pass = 0;
@@ -123,9 +124,9 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-// The median-of-frames measurement of issue 5: `warmup` frames, then `frames` frames, each
-// with the environment rotated by `degrees_per_frame` more about `axis` (so constants are
-// recomputed every frame, inside the timing), each ended by glFinish.
+// The median-of-frames measurement (docs/ARCHITECTURE.md "Rendering", Timing): `warmup` frames,
+// then `frames` frames, each with the environment rotated by `degrees_per_frame` more about `axis`
+// (so constants are recomputed every frame, inside the timing), each ended by glFinish.
 struct TimingSummary {
   int frames = 0;
   double frame_ms_median = 0, cpu_ms_median = 0, gl_ms_median = 0;

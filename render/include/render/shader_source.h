@@ -1,9 +1,9 @@
 // render/shader_source.h: GLSL 4.50 sources, generated for one constant layout.
 //
-// Why generated: on llvmpipe (issue 5, measured) a vertex shader whose uniform indices are
-// all compile-time constants runs ~2.9x faster than one with any non-constant index (a loop
-// counter, a per-vertex cluster id, an SSBO read). So the SH basis and the CPCA sums are
-// emitted as straight-line code with literal coefficients and literal register offsets; the
+// Why generated: on llvmpipe (measured; docs/ARCHITECTURE.md "Rendering") a vertex shader whose
+// uniform indices are all compile-time constants runs ~2.9x faster than one with any non-constant
+// index (a loop counter, a per-vertex cluster id, an SSBO read). So the SH basis and the CPCA sums
+// are emitted as straight-line code with literal coefficients and literal register offsets; the
 // only non-constant index left is the per-vertex cluster base where a path needs one.
 //
 // Vertex attribute locations, shared with the renderer:

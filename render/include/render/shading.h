@@ -1,5 +1,6 @@
 // render/shading.h: the per-frame lighting constants of CPCA rendering and the per-vertex
-// radiance they give, computed on the CPU (thesis ch. 3.2, DESIGN.md "Rendering").
+// radiance they give, computed on the CPU (thesis ch. 3.2, docs/ARCHITECTURE.md
+// "Rendering").
 //
 // With l the rotated world-frame SH lighting (n x 3) and, for cluster k, mat(m_k) and
 // mat(B_kj) the transfer matrices of its mean and components (n x n glossy, n x 1 diffuse),

@@ -1,0 +1,61 @@
+#include "compress_flags.h"
+
+#include "cpca/compressed.h"
+#include "flag_checks.h"
+
+namespace prtr_app {
+
+void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
+  cpca::CompressOptions& o = f.compress;
+  const bool per_row = set == CompressFlagSet::kPerRow;
+  if (!per_row) {
+    cmd->add_option("--clusters", o.clusters, "Number of CPCA clusters K")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+  }
+  cmd->add_option("--pcs", o.components, "Principal components per cluster N")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  if (!per_row) {
+    cmd->add_option("--method", f.method,
+                    "lbg: LBG then PCA per cluster; iterative: Sloan et al. 2003 iterative CPCA")
+        ->check(CLI::IsMember(cpca::cluster_method_names()))
+        ->capture_default_str();
+  }
+  cmd->add_option("--alpha", o.alpha,
+                  "Geometry-coherence weight (thesis eq. 9-10; 0 = off, the thesis used 0.05)")
+      ->check(finite_number())
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  if (!per_row) {
+    cmd->add_flag("--overdraw-reduction", o.overdraw_reduction,
+                  "Move border vertices to neighbouring clusters to cut multi-cluster triangles");
+  }
+  cmd->add_option("--overdraw-tolerance", o.overdraw.tolerance,
+                  "Overdraw reduction: largest error increase per move, in units of the Average SE")
+      ->check(finite_number())
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  if (set != CompressFlagSet::kCompress) return;
+  cmd->add_option("--pca", f.pca, "power: power iteration (SLF paper); eigen: Eigen's solver")
+      ->check(CLI::IsMember(cpca::pca_solver_names()))
+      ->capture_default_str();
+  cmd->add_option("--seed", o.seed, "Seed of the hyper-box initialisation")->capture_default_str();
+  cmd->add_option("--threshold", o.lbg_threshold,
+                  "LBG stops when the energy ratio (E_{i-1} - E_i) / E_{i-1} falls below this")
+      ->check(finite_number())
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--max-iterations", o.lbg_max_iterations, "LBG iteration cap")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+}
+
+cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
+  cpca::CompressOptions o = f.compress;
+  o.method = cpca::parse_cluster_method(f.method);
+  o.solver = cpca::parse_pca_solver(f.pca);
+  return o;
+}
+
+}  // namespace prtr_app

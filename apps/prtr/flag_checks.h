@@ -1,0 +1,25 @@
+// apps/prtr/flag_checks.h: CLI11 validators the commands share. CLI::Range lets NaN through
+// (every comparison with NaN is false), and an infinite angle or exposure only fails deep in
+// the pipeline with a message that does not name the flag, so floating-point flags are
+// checked for finiteness where they are parsed: exit 2 naming the flag.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <string>
+
+namespace prtr_app {
+
+inline CLI::Validator finite_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+        if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
+        return {};
+      },
+      "FINITE");
+}
+
+}  // namespace prtr_app

@@ -1,0 +1,77 @@
+// apps/prtr/overdraw_run.h: the overdraw benchmark (thesis tables 5.2-5.17, ch. 5) as a
+// library: a plan in, an OverdrawReport out (overdraw_report.h renders it). prtr overdraw
+// only parses flags into a plan and prints the report; other drivers (a viewer, a research
+// sweep) build their own plans.
+//
+// For every cluster count K and method row it compresses the bake through the shared cache
+// (apps/prtr/pipeline.h, which also keeps each compression's clustering time and errors, so a
+// cached row reports what was measured), then for every register budget and super-cluster
+// strategy it measures one row: the exact average triangle overdraw (cpca::overdraw), the
+// multipass render with that grouping, a check that the triangles GL counted equal the
+// prediction (a mismatch is a bug and stops the run), FPS with the same camera and frames for
+// every row, and the image RMSE against the uncompressed render. Per K, the single-pass and
+// decoupled paths show what the overdraw costs.
+#pragma once
+
+#include "overdraw_report.h"
+
+#include "cpca/compress.h"
+#include "prt/bake.h"
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace prtr_app {
+
+// A plan that cannot run as given (unknown name, a size the data does not allow); the
+// message names the flag that sets the field. Other errors are failures of the run.
+class PlanError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+// One method row: the thesis's four, and iterative CPCA with both (ours).
+struct MethodPreset {
+  const char* name;
+  const char* summary;
+  bool coherence, overdraw_reduction, iterative;
+};
+// PlanError listing the names for an unknown one.
+const MethodPreset& find_method(const std::string& name);
+std::string method_names();  // "original, overdraw-reduction, ..."
+
+struct OverdrawPlan {
+  std::string mesh, probe;
+  std::string transfer;  // a bake of the mesh; empty: bake with `bake` through the cache
+  prt::BakeOptions bake;
+  std::string cache;                    // directory of cached bakes and compressions
+  bool recompress = false;              // ignore cached compressions (still writes them)
+  std::vector<int> clusters;            // K
+  std::vector<std::string> methods;     // MethodPreset names
+  std::vector<std::string> strategies;  // cpca::group_clusters names
+  std::vector<std::string> budgets;     // "default", "thesis" or a vec4 count
+  // Everything but K, method, alpha and overdraw reduction, which the rows set; `alpha` is
+  // the coherence rows' weight.
+  cpca::CompressOptions compress;
+  int frames = 10, warmup = 2, width = 1280, height = 948;
+  double degrees_per_frame = 1.0, image_degrees = 37.0;
+  bool modes = true;     // single-pass / decoupled / uncompressed timings
+  bool quiet = true;     // no progress bar while baking
+  std::string pictures;  // directory for the cluster and overdraw pictures; empty: none
+  std::function<void(const std::string&)> note;  // one-line events (may be empty)
+  std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
+};
+
+// Checks names and sizes that need no data (PlanError); run_overdraw calls it first.
+void validate(const OverdrawPlan& plan);
+
+OverdrawReport run_overdraw(const OverdrawPlan& plan);
+
+// The budget whose rows the plot and the pictures show: "thesis" when measured, else the
+// first (plot) or last (pictures) budget.
+std::string plot_budget(const std::vector<std::string>& budgets);
+
+}  // namespace prtr_app

@@ -1,0 +1,409 @@
+// The paths that shade from CPCA constants (render/renderer.h): multipass, single-pass,
+// decoupled and CPU. They share the constant slots (cluster -> offset in one buffer), the
+// per-frame constants (render/shading.h) and the per-vertex cluster data; they differ in how
+// clusters are grouped into passes, how the constants are bound and who shades.
+#include "common/check.h"
+#include "render/gl_context.h"
+#include "render/shader_source.h"
+#include "render_path.h"
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace render {
+namespace {
+
+// Where each cluster's constants live: slots of registers_per_cluster vec4, pass by pass,
+// each pass starting at a UBO-aligned offset (its range); `per_cluster_aligned` aligns every
+// cluster (decoupled binds each on its own).
+struct SlotPlan {
+  cpca::SuperClusters groups;
+  std::vector<std::uint32_t> slot_of;  // cluster -> slot
+  std::vector<GLintptr> pass_offset;   // bytes
+  int slots_per_pass = 1;
+  int total_slots = 0;  // with room for a full-size range from the last pass's start
+};
+
+// The vec4 budget of one pass, checked against the context and one cluster's cost, and the
+// clusters one pass holds. Messages name the flags, as these come from the command line.
+int clusters_per_pass(const PathInput& in, int registers) {
+  const int context_budget = current_gl_info().default_register_budget();
+  const int budget = in.options.register_budget > 0 ? in.options.register_budget : context_budget;
+  if (budget > context_budget)
+    throw std::invalid_argument("--register-budget " + std::to_string(budget) +
+                                " exceeds what the GL context offers (" +
+                                std::to_string(context_budget) + " vec4); lower it");
+  if (budget < registers)
+    throw std::invalid_argument(
+        "--register-budget " + std::to_string(budget) + " is below one cluster's " +
+        std::to_string(registers) + " vec4 (order " + std::to_string(in.set->order) + ", " +
+        std::to_string(in.set->component_count) + " PCs); raise it or use fewer PCs");
+  int per_pass = budget / registers;
+  if (in.options.clusters_per_pass > 0) {
+    if (in.options.clusters_per_pass > per_pass)
+      throw std::invalid_argument(
+          "--clusters-per-pass " + std::to_string(in.options.clusters_per_pass) + " needs " +
+          std::to_string(in.options.clusters_per_pass * registers) + " vec4 but the budget is " +
+          std::to_string(budget) + "; lower it or raise --register-budget");
+    per_pass = in.options.clusters_per_pass;
+  }
+  in.stats.register_budget = budget;
+  in.stats.registers_per_cluster = registers;
+  return per_pass;
+}
+
+// The grouping: the caller's (checked against the capacity) for the paths that split, else
+// clusters in order.
+cpca::SuperClusters group(const PathInput& in, int per_pass, bool split) {
+  const int K = in.set->cluster_count;
+  in.stats.clusters_per_pass = split ? per_pass : K;
+  if (!in.options.groups || !split)
+    return cpca::group_in_order(K, split ? per_pass : std::max(1, K));
+  cpca::SuperClusters groups = *in.options.groups;
+  groups.pass_of = cpca::pass_of_clusters(groups, K);
+  for (std::size_t p = 0; p < groups.passes.size(); ++p)
+    if (int(groups.passes[p].size()) > per_pass)
+      throw std::invalid_argument("super-cluster " + std::to_string(p) + " holds " +
+                                  std::to_string(groups.passes[p].size()) +
+                                  " clusters but a pass fits " + std::to_string(per_pass) +
+                                  " within the register budget");
+  return groups;
+}
+
+SlotPlan plan_slots(cpca::SuperClusters groups, int cluster_count, int registers,
+                    bool per_cluster_aligned) {
+  GLint align = 16;
+  glGetIntegerv(GL_UNIFORM_BUFFER_OFFSET_ALIGNMENT, &align);
+  SlotPlan plan;
+  for (const auto& pass : groups.passes)
+    plan.slots_per_pass = std::max(plan.slots_per_pass, int(pass.size()));
+  const GLintptr cluster_bytes = GLintptr(registers) * 16;
+  auto aligned = [&](int slot) {
+    while ((GLintptr(slot) * cluster_bytes) % align != 0) ++slot;
+    return slot;
+  };
+  plan.slot_of.assign(std::size_t(cluster_count), 0);
+  int next = 0;
+  for (const auto& pass : groups.passes) {
+    next = aligned(next);
+    plan.pass_offset.push_back(GLintptr(next) * cluster_bytes);
+    for (std::uint32_t k : pass) {
+      if (per_cluster_aligned) next = aligned(next);
+      plan.slot_of[k] = std::uint32_t(next++);
+    }
+  }
+  plan.total_slots = next + plan.slots_per_pass;
+  plan.groups = std::move(groups);
+  return plan;
+}
+
+// What every cluster path shares: the slot plan, constants and their buffer, the GPU mesh
+// with per-vertex slot, pass and weights.
+class ClusterPath : public RenderPath {
+ public:
+  // `sort_by_slot`: store vertices sorted by constant slot (each cluster one vertex range).
+  ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot)
+      : constants_(*in.set), layout_(constants_.layout()) {
+    const int per_pass = clusters_per_pass(in, layout_.registers_per_cluster());
+    plan_ = plan_slots(group(in, per_pass, split), in.set->cluster_count,
+                       layout_.registers_per_cluster(), per_cluster_aligned);
+    host_.assign(std::size_t(plan_.total_slots) * layout_.floats_stride(), 0.f);
+    mesh_ = std::make_unique<GpuMesh>(in.mesh, vertex_order(*in.set, sort_by_slot),
+                                      in.options.optimize_vertex_cache);
+    gpu_set_ = reordered_set(*in.set);
+    pass_of_vertex_.assign(mesh_->vertex_count(), 0);
+    if (!plan_.groups.pass_of.empty())
+      for (std::size_t i = 0; i < pass_of_vertex_.size(); ++i)
+        pass_of_vertex_[i] = plan_.groups.pass_of[in.set->cluster_of[mesh_->old_of_new()[i]]];
+  }
+  ~ClusterPath() override { glDeleteBuffers(1, &constant_buffer_); }
+
+  void update(const Eigen::MatrixXd& lit, const Camera&) override {
+    constants_.compute(lit, plan_.slot_of, host_.data());
+    glBindBuffer(constant_target_, constant_buffer_);
+    glBufferSubData(constant_target_, 0, GLsizeiptr(host_.size() * 4), host_.data());
+  }
+
+ protected:
+  // The per-vertex attributes, the index ranges (whole mesh, then `pass_lists`), and the
+  // constant buffer bound as `target`.
+  void upload(const std::vector<std::uint32_t>& cluster_attribute,
+              const std::vector<std::vector<std::uint32_t>>& pass_lists, GLenum target,
+              bool shaded_on_gpu) {
+    whole_ = mesh_->add_all_triangles();
+    for (const auto& list : pass_lists) pass_ranges_.push_back(mesh_->add_triangles(list));
+    mesh_->uint_attribute(kAttrCluster, cluster_attribute);
+    mesh_->uint_attribute(kAttrPass, pass_of_vertex_);
+    const int N = gpu_set_.component_count;
+    const int vectors = (N + 3) / 4;
+    if (shaded_on_gpu && kAttrWeights + vectors > kAttrRadiance)
+      throw std::invalid_argument(std::to_string(N) + " PCs need " + std::to_string(vectors) +
+                                  " weight attributes but the GL context offers " +
+                                  std::to_string(kAttrRadiance - kAttrWeights) +
+                                  " (at most 40 PCs); compress with fewer PCs");
+    mesh_->weight_attributes(gpu_set_.weights, N, shaded_on_gpu);
+    mesh_->upload_indices();
+    constant_target_ = target;
+    constant_buffer_ = make_buffer(target, GLsizeiptr(host_.size() * 4), nullptr, GL_DYNAMIC_DRAW);
+  }
+
+  // Each vertex's slot (what the single-pass, decoupled and CPU shaders index by).
+  std::vector<std::uint32_t> slots() const { return gpu_set_.cluster_of; }
+
+  GLsizeiptr cluster_bytes() const { return GLsizeiptr(layout_.registers_per_cluster()) * 16; }
+
+  ShadingConstants constants_;
+  ConstantLayout layout_;
+  SlotPlan plan_;
+  cpca::CompressedSet gpu_set_;  // in GPU vertex order; cluster_of holds slots, not ids
+  std::vector<float> host_;
+  std::vector<std::uint32_t> pass_of_vertex_;
+  std::vector<IndexRange> pass_ranges_;
+  GLuint constant_buffer_ = 0;
+  GLenum constant_target_ = GL_UNIFORM_BUFFER;
+
+ private:
+  std::vector<std::uint32_t> vertex_order(const cpca::CompressedSet& set, bool sort) const {
+    std::vector<std::uint32_t> order(set.vertex_count);
+    std::iota(order.begin(), order.end(), 0u);
+    if (sort)
+      std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return plan_.slot_of[set.cluster_of[a]] < plan_.slot_of[set.cluster_of[b]];
+      });
+    return order;
+  }
+
+  cpca::CompressedSet reordered_set(const cpca::CompressedSet& set) const {
+    const std::size_t V = mesh_->vertex_count();
+    const int N = set.component_count;
+    cpca::CompressedSet out;
+    out.component_count = N;
+    out.cluster_of.resize(V);
+    out.weights.resize(V * std::size_t(N));
+    for (std::size_t i = 0; i < V; ++i) {
+      const std::uint32_t o = mesh_->old_of_new()[i];
+      out.cluster_of[i] = plan_.slot_of[set.cluster_of[o]];
+      std::copy_n(set.weights.data() + o * std::size_t(N), N,
+                  out.weights.data() + i * std::size_t(N));
+    }
+    return out;
+  }
+};
+
+// Depth pre-pass, then one additive pass per super-cluster with GL_EQUAL depth, each binding
+// its clusters' constants as one UBO range and drawing only its own triangles.
+class MultipassPath : public ClusterPath {
+ public:
+  explicit MultipassPath(const PathInput& in) : ClusterPath(in, true, false, true) {
+    std::vector<cpca::TriangleIndices> tris(in.mesh.triangles.begin(), in.mesh.triangles.end());
+    const cpca::OverdrawStats od = cpca::overdraw(in.set->cluster_of, tris, plan_.groups);
+    in.stats.triangles_per_pass = od.triangles_per_pass;
+    in.stats.average_overdraw = od.average_overdraw;
+    in.stats.passes = int(plan_.groups.passes.size());
+    // Within a pass the shader indexes by the slot relative to the pass's range.
+    std::vector<std::uint32_t> relative = slots();
+    for (std::size_t i = 0; i < relative.size(); ++i)
+      relative[i] -= std::uint32_t(plan_.pass_offset[pass_of_vertex_[i]] / cluster_bytes());
+    upload(relative, cpca::triangles_per_pass(in.set->cluster_of, tris, plan_.groups),
+           GL_UNIFORM_BUFFER, true);
+    depth_program_ =
+        GlProgram("depth pre-pass", position_vertex_shader(), coverage_fragment_shader());
+    shade_program_ = GlProgram(
+        "multipass shading",
+        compressed_vertex_shader(layout_, ConstantAccess::kUniformSlot, plan_.slots_per_pass, true),
+        radiance_fragment_shader(), true);
+  }
+
+  std::size_t passes() const override { return pass_ranges_.size(); }
+  bool pass_drew(std::size_t p) const override { return pass_ranges_[p].count > 0; }
+
+  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
+    set_camera_uniforms(depth_program_, camera);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);  // rgb = 0, alpha = coverage
+    glDepthFunc(GL_LESS);
+    mesh_->draw(whole_);
+    set_camera_uniforms(shade_program_, camera);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
+    glDepthFunc(GL_EQUAL);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    for (std::size_t p = 0; p < pass_ranges_.size(); ++p) {
+      if (pass_ranges_[p].count == 0) continue;
+      bind_pass(p);
+      if (!queries.empty()) glBeginQuery(GL_PRIMITIVES_GENERATED, queries[p]);
+      mesh_->draw(pass_ranges_[p]);
+      if (!queries.empty()) glEndQuery(GL_PRIMITIVES_GENERATED);
+    }
+    glDisable(GL_BLEND);
+  }
+
+  // Vertices outside a pass output zero, so the passes' captures sum to the radiance.
+  std::vector<Rgb> capture(const Camera& camera) override {
+    set_camera_uniforms(shade_program_, camera);
+    std::vector<Rgb> radiance(mesh_->vertex_count(), Rgb::Zero());
+    for (std::size_t p = 0; p < plan_.pass_offset.size(); ++p) {
+      bind_pass(p);
+      mesh_->capture_points(radiance, true);
+    }
+    return radiance;
+  }
+
+ private:
+  void bind_pass(std::size_t p) {
+    glUniform1ui(shade_program_.uniform("u_pass"), GLuint(p));
+    glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, plan_.pass_offset[p],
+                      GLsizeiptr(plan_.slots_per_pass) * cluster_bytes());
+  }
+
+  GlProgram depth_program_, shade_program_;
+};
+
+// All clusters' constants in one SSBO indexed by the vertex's slot; one draw.
+class SinglepassPath : public ClusterPath {
+ public:
+  explicit SinglepassPath(const PathInput& in) : ClusterPath(in, false, false, true) {
+    upload(slots(), {}, GL_SHADER_STORAGE_BUFFER, true);
+    program_ = GlProgram("single-pass shading",
+                         compressed_vertex_shader(layout_, ConstantAccess::kStorage, 0, false),
+                         radiance_fragment_shader(), true);
+  }
+  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kConstantsBinding, constant_buffer_);
+    draw_whole(program_, camera, queries);
+  }
+  std::vector<Rgb> capture(const Camera& camera) override {
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kConstantsBinding, constant_buffer_);
+    return capture_whole(program_, camera);
+  }
+
+ private:
+  GlProgram program_;
+};
+
+// Each cluster's vertices (one contiguous range, as vertices are sorted by slot) shaded once
+// as points with only its constants bound, so every register index is a literal; transform
+// feedback writes the radiance in place; then one pass-through draw of all triangles.
+class DecoupledPath : public ClusterPath {
+ public:
+  explicit DecoupledPath(const PathInput& in) : ClusterPath(in, true, true, true) {
+    upload(slots(), {}, GL_UNIFORM_BUFFER, true);
+    find_cluster_ranges(in.set->cluster_count);
+    shade_program_ =
+        GlProgram("decoupled shading",
+                  compressed_vertex_shader(layout_, ConstantAccess::kUniformFixed, 1, false),
+                  radiance_fragment_shader(), true);
+    passthrough_program_ =
+        GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
+  }
+  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
+    shade(camera);
+    draw_whole(passthrough_program_, camera, queries);
+  }
+  std::vector<Rgb> capture(const Camera& camera) override {
+    shade(camera);
+    std::vector<Rgb> radiance;
+    mesh_->read(mesh_->radiance_buffer(), radiance, false);
+    return radiance;
+  }
+
+ private:
+  void find_cluster_ranges(int cluster_count) {
+    std::vector<std::uint32_t> by_slot{};
+    by_slot.resize(std::size_t(cluster_count));
+    std::iota(by_slot.begin(), by_slot.end(), 0u);
+    std::sort(by_slot.begin(), by_slot.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return plan_.slot_of[a] < plan_.slot_of[b];
+    });
+    const std::size_t V = mesh_->vertex_count();
+    std::size_t v = 0;
+    for (std::uint32_t k : by_slot) {
+      const std::size_t first = v;
+      while (v < V && gpu_set_.cluster_of[v] == plan_.slot_of[k]) ++v;
+      if (v > first) {
+        ranges_.push_back({GLint(first), GLsizei(v - first)});
+        offsets_.push_back(GLintptr(plan_.slot_of[k]) * cluster_bytes());
+      }
+    }
+    PRTR_DCHECK(v == V);  // every vertex in exactly one cluster range
+  }
+
+  void shade(const Camera& camera) {
+    set_camera_uniforms(shade_program_, camera);
+    glEnable(GL_RASTERIZER_DISCARD);
+    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, mesh_->radiance_buffer());
+    glBeginTransformFeedback(GL_POINTS);
+    for (std::size_t i = 0; i < ranges_.size(); ++i) {
+      glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, offsets_[i],
+                        cluster_bytes());
+      glDrawArrays(GL_POINTS, ranges_[i].first, ranges_[i].second);
+    }
+    glEndTransformFeedback();
+    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+    glDisable(GL_RASTERIZER_DISCARD);
+  }
+
+  struct VertexRange {
+    GLint first;
+    GLsizei second;
+  };
+  std::vector<VertexRange> ranges_;
+  std::vector<GLintptr> offsets_;  // bytes, one per range
+  GlProgram shade_program_, passthrough_program_;
+};
+
+// The same constants, per-vertex radiance in C++ (render/shading.h), drawn pass-through.
+class CpuPath : public ClusterPath {
+ public:
+  explicit CpuPath(const PathInput& in) : ClusterPath(in, false, false, false) {
+    upload(slots(), {}, GL_UNIFORM_BUFFER, false);
+    program_ =
+        GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
+  }
+  void update(const Eigen::MatrixXd& lit, const Camera& camera) override {
+    constants_.compute(lit, plan_.slot_of, host_.data());
+    shade_vertices(gpu_set_, layout_, host_.data(), mesh_->mesh(), camera.eye, radiance_);
+    glBindBuffer(GL_ARRAY_BUFFER, mesh_->radiance_buffer());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(radiance_.size() * 12), radiance_.data());
+  }
+  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
+    draw_whole(program_, camera, queries);
+  }
+  std::vector<Rgb> capture(const Camera&) override { return radiance_; }
+
+ private:
+  GlProgram program_;
+  std::vector<Rgb> radiance_;
+};
+
+}  // namespace
+
+std::unique_ptr<RenderPath> make_cluster_path(const PathInput& in) {
+  if (!in.set)
+    throw std::invalid_argument("mode " + std::string(mode_name(in.options.mode)) +
+                                " needs a compressed set");
+  cpca::validate(*in.set);
+  if (in.set->vertex_count != in.mesh.vertex_count())
+    throw std::invalid_argument("the compressed set has " + std::to_string(in.set->vertex_count) +
+                                " vertices but the mesh has " +
+                                std::to_string(in.mesh.vertex_count()) +
+                                "; use the mesh it was baked from");
+  switch (in.options.mode) {
+    case Mode::kMultipass:
+      return std::make_unique<MultipassPath>(in);
+    case Mode::kSinglepass:
+      return std::make_unique<SinglepassPath>(in);
+    case Mode::kDecoupled:
+      return std::make_unique<DecoupledPath>(in);
+    case Mode::kCpu:
+      return std::make_unique<CpuPath>(in);
+    case Mode::kUncompressed:
+      break;
+  }
+  throw std::invalid_argument("mode " + std::string(mode_name(in.options.mode)) +
+                              " is not a cluster path");
+}
+
+}  // namespace render

@@ -1,0 +1,63 @@
+#include "frame_target.h"
+
+#include "render/gl_context.h"
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+namespace render {
+
+FrameTarget::~FrameTarget() {
+  glDeleteFramebuffers(1, &fbo_);
+  glDeleteRenderbuffers(1, &colour_);
+  glDeleteRenderbuffers(1, &depth_);
+}
+
+void FrameTarget::bind(int width, int height) {
+  if (!fbo_ || width != width_ || height != height_) {
+    if (!fbo_) {
+      glGenFramebuffers(1, &fbo_);
+      glGenRenderbuffers(1, &colour_);
+      glGenRenderbuffers(1, &depth_);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, colour_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE)
+      throw GlError("framebuffer " + std::to_string(width) + " x " + std::to_string(height) +
+                    " RGBA32F + depth is incomplete (status " + std::to_string(status) +
+                    "); try a smaller --width/--height");
+    check_gl("Renderer: framebuffer");
+    width_ = width;
+    height_ = height;
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glViewport(0, 0, width, height);
+}
+
+Image FrameTarget::read() const {
+  Image image;
+  image.width = width_;
+  image.height = height_;
+  image.rgba.resize(std::size_t(image.width) * image.height * 4);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  std::vector<float> rows(image.rgba.size());
+  glReadPixels(0, 0, image.width, image.height, GL_RGBA, GL_FLOAT, rows.data());
+  check_gl("Renderer::read_image");
+  // GL's row 0 is the bottom one.
+  const std::size_t row = std::size_t(image.width) * 4;
+  for (int y = 0; y < image.height; ++y)
+    std::copy_n(rows.data() + std::size_t(image.height - 1 - y) * row, row,
+                image.rgba.data() + std::size_t(y) * row);
+  return image;
+}
+
+}  // namespace render

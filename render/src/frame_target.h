@@ -1,0 +1,29 @@
+// render/src/frame_target.h (private): the offscreen RGBA32F + 32-bit float depth framebuffer
+// every draw of the renderer goes to, (re)allocated when the camera's size changes.
+#pragma once
+
+#include "gl_program.h"
+#include "render/image.h"
+
+namespace render {
+
+class FrameTarget {
+ public:
+  FrameTarget() = default;
+  ~FrameTarget();
+  FrameTarget(const FrameTarget&) = delete;
+  FrameTarget& operator=(const FrameTarget&) = delete;
+
+  // Binds the framebuffer at this size (allocating it first when the size changed) and sets
+  // the viewport. GlError when the driver cannot provide it.
+  void bind(int width, int height);
+  bool empty() const { return fbo_ == 0; }
+  // The colour buffer, row 0 at the top.
+  Image read() const;
+
+ private:
+  GLuint fbo_ = 0, colour_ = 0, depth_ = 0;
+  int width_ = 0, height_ = 0;
+};
+
+}  // namespace render

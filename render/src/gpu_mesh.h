@@ -1,0 +1,68 @@
+// render/src/gpu_mesh.h (private): a mesh on the GPU in a render path's vertex order, shared
+// by every path: positions, normals and tangents, a radiance buffer (what transform feedback
+// writes and the pass-through shader reads), optional per-vertex cluster data, and index
+// ranges (the whole mesh, or one per pass), each in vertex-cache order.
+#pragma once
+
+#include "gl_program.h"
+#include "meshes/mesh.h"
+#include "render/camera.h"
+#include "render/shading.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace render {
+
+struct IndexRange {
+  GLsizeiptr first = 0;  // in indices
+  GLsizei count = 0;
+};
+
+GLuint make_buffer(GLenum target, GLsizeiptr bytes, const void* data, GLenum usage);
+
+// Uses `program` and sets the camera uniforms every mesh shader declares.
+void set_camera_uniforms(GlProgram& program, const Camera& camera);
+
+class GpuMesh {
+ public:
+  // `old_of_new[i]` is the source vertex stored at GPU vertex i.
+  GpuMesh(const meshes::Mesh& source, std::vector<std::uint32_t> old_of_new,
+          bool optimize_vertex_cache);
+  ~GpuMesh();
+  GpuMesh(const GpuMesh&) = delete;
+  GpuMesh& operator=(const GpuMesh&) = delete;
+
+  const meshes::Mesh& mesh() const { return mesh_; }  // in GPU vertex order
+  const std::vector<std::uint32_t>& old_of_new() const { return old_of_new_; }
+  std::size_t vertex_count() const { return old_of_new_.size(); }
+
+  // One index range of the source triangles `ids`; upload_indices() after the last one.
+  IndexRange add_triangles(const std::vector<std::uint32_t>& ids);
+  IndexRange add_all_triangles();
+  void upload_indices();
+
+  void uint_attribute(GLuint location, const std::vector<std::uint32_t>& values);
+  // `components` floats per vertex, padded to vec4 attributes from kAttrWeights on; the
+  // attributes are enabled only when `enable` (paths that shade on the CPU do not read them).
+  void weight_attributes(const std::vector<float>& weights, int components, bool enable);
+
+  void bind() const { glBindVertexArray(vao_); }
+  void draw(const IndexRange& range) const;
+  GLuint radiance_buffer() const { return radiance_; }
+
+  // Per-vertex RGB of `buffer` (after glFinish), added to or replacing `into`.
+  void read(GLuint buffer, std::vector<Rgb>& into, bool add) const;
+  // Draws every vertex once as a point with the current program and captures v_radiance.
+  void capture_points(std::vector<Rgb>& into, bool add) const;
+
+ private:
+  meshes::Mesh mesh_;
+  std::vector<std::uint32_t> old_of_new_;
+  bool optimize_ = true;
+  GLuint vao_ = 0, radiance_ = 0, capture_ = 0, ibo_ = 0;
+  std::vector<GLuint> buffers_;
+  std::vector<std::uint32_t> indices_;
+};
+
+}  // namespace render
