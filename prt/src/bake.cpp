@@ -376,10 +376,13 @@ void record_front_hits(const BakeContext& ctx, ShadowScratch& s, int k,
 }
 
 // Direct light: the shadow-pass transfer of every vertex into out, and (with bounces) the
-// front hits each vertex's occluded rays find.
+// front hits each vertex's occluded rays find. nearly_occluded[p] = 1 where p sees less than
+// kNearlyOccluded of its rays escape.
 void shadow_pass(const BakeContext& ctx, ShadowPool& pool, std::vector<HitBlock>& hit_blocks,
-                 TransferSet& out, ProgressReporter& progress) {
+                 TransferSet& out, std::vector<std::uint8_t>& nearly_occluded,
+                 ProgressReporter& progress) {
   const bool keep_hits = ctx.options.bounces > 0;
+  const double visible_floor = kNearlyOccluded * ctx.setup.samples;
   progress.start_pass(0);
   tbb::parallel_for(std::uint64_t(0), ctx.chunks, [&](std::uint64_t chunk) {
     ShadowScratch& s = pool.local();
@@ -390,6 +393,7 @@ void shadow_pass(const BakeContext& ctx, ShadowPool& pool, std::vector<HitBlock>
       const Eigen::Matrix3f frame = frame_of(ctx.mesh, p);
       const Eigen::Vector3f origin = ctx.mesh.positions[p] + ctx.offset * ctx.offset_dirs[p];
       const int k = trace_shadow_rays(ctx, s, frame, origin);
+      nearly_occluded[p] = double(ctx.setup.samples - k) < visible_floor ? 1 : 0;
       if (ctx.glossy) {
         glossy_shadow_transfer(ctx, s, k, frame, out, p);
       } else {
@@ -545,8 +549,12 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
   ShadowPool shadow_pool([&] { return ShadowScratch(o.order, setup.n, setup.samples); });
 
   auto start_pass = Clock::now();
-  shadow_pass(ctx, shadow_pool, hit_blocks, out, progress);
+  std::vector<std::uint8_t> nearly_occluded(ctx.vertex_count);
+  shadow_pass(ctx, shadow_pool, hit_blocks, out, nearly_occluded, progress);
   st.seconds_shadow = seconds_since(start_pass);
+  for (std::uint64_t p = 0; p < ctx.vertex_count; ++p) {
+    if (nearly_occluded[p]) st.occluded_vertices.push_back(std::uint32_t(p));
+  }
   start_pass = Clock::now();
   if (o.bounces > 0) bounce_passes(ctx, hit_blocks, out, progress);
   st.seconds_bounces = seconds_since(start_pass);

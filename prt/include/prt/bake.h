@@ -33,6 +33,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace prt {
 
@@ -74,10 +75,16 @@ BakeEstimate estimate_bake(const meshes::Mesh& mesh, const BakeOptions& options)
 // Bytes of memory available now (MemAvailable in /proc/meminfo), 0 if unknown.
 std::uint64_t available_memory();
 
+// A vertex is nearly occluded when less than this share of its shadow rays escapes.
+inline constexpr double kNearlyOccluded = 0.01;
+
 struct BakeStats {
   double seconds_shadow = 0, seconds_bounces = 0, seconds_brdf = 0, seconds_total = 0;
   std::uint64_t rays_shadow = 0, rays_bounce = 0;
   double occluded_fraction = 0;
+  // Nearly occluded vertices, ascending. A sound surface rarely has any: they render black,
+  // and point at enclosed or broken geometry (or rays that start inside the surface).
+  std::vector<std::uint32_t> occluded_vertices;
 };
 
 // The mesh must have frames (meshes::compute_frames). Throws std::invalid_argument for bad
