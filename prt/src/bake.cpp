@@ -118,13 +118,29 @@ class ProgressReporter {
   Clock::time_point last_{};
 };
 
-// Direction of each vertex's ray-origin offset: the normalised sum of the (area-weighted)
-// normals of every triangle at its position, across split vertices too. On a welded mesh
-// this is the vertex normal. Where a hard edge is modelled with split vertices (the open
-// box's rims) it points between the faces, so the origin clears both: offsetting along the
-// vertex's own normal leaves it on the other face's plane, where rays into that face slip
-// through the crease and see the sky.
-std::vector<meshes::Vec3> ray_offset_directions(const meshes::Mesh& mesh) {
+// Where each vertex's rays start (prt/bake.h, "Ray origins"; docs/ARCHITECTURE.md, "Baking
+// (prt/)"). Every triangle at a vertex's position, split vertices included, offers a start
+// point: a step from the corner into the triangle, toward its centroid, lifted a tenth of
+// that step along its normal. A ray starts from the face whose plane it rises most steeply
+// above. One shared origin cannot be outside everywhere: at a pit or a crease the outside
+// near the vertex is a narrow wedge, and a fixed direction can miss it.
+struct OriginFaces {
+  std::vector<std::uint32_t> group;  // vertex -> position group
+  std::vector<std::uint32_t> first;  // group g's entries are [first[g], first[g + 1])
+  Eigen::Matrix3Xf normals;          // unit face normal of each entry
+  Eigen::Matrix3Xf steps;            // corner to start point, in world units
+};
+
+// Start points sit kStep x offset into their face and kLift of that above it. The lift keeps
+// them ~50 float ulps off their own face's plane at the default offset (1e-4 of the
+// diagonal), so Embree cannot report the face itself, yet small against the step, so a
+// start point stays inside wedges down to ~10 degrees between faces. The step is a tenth of
+// the offset because the bunny's pits fold at that scale: their visibility converges to a
+// brute-force count from a point just outside as the step shrinks (docs/ARCHITECTURE.md).
+constexpr float kStep = 0.1f;
+constexpr float kLift = 0.1f;
+
+OriginFaces origin_faces(const meshes::Mesh& mesh, float offset) {
   struct Key {
     float x, y, z;
     bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
@@ -135,26 +151,45 @@ std::vector<meshes::Vec3> ray_offset_directions(const meshes::Mesh& mesh) {
              (std::hash<float>()(k.z) * 131);
     }
   };
-  std::unordered_map<Key, std::size_t, KeyHash> group_of;
-  std::vector<std::size_t> group(mesh.vertex_count());
+  OriginFaces f;
+  std::unordered_map<Key, std::uint32_t, KeyHash> group_of;
+  f.group.resize(mesh.vertex_count());
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
     const meshes::Vec3& p = mesh.positions[v];
-    group[v] = group_of.emplace(Key{p.x(), p.y(), p.z()}, group_of.size()).first->second;
+    f.group[v] =
+        group_of.emplace(Key{p.x(), p.y(), p.z()}, std::uint32_t(group_of.size())).first->second;
   }
-  std::vector<meshes::Vec3> sum(group_of.size(), meshes::Vec3::Zero());
+  // Zero-area faces have no plane to start above; they are left out.
+  auto unit_normal = [&](const meshes::Triangle& t) {
+    return (mesh.positions[t[1]] - mesh.positions[t[0]])
+        .cross(mesh.positions[t[2]] - mesh.positions[t[0]])
+        .normalized()
+        .eval();
+  };
+  f.first.assign(group_of.size() + 1, 0);
   for (const meshes::Triangle& t : mesh.triangles) {
-    const meshes::Vec3 face = (mesh.positions[t[1]] - mesh.positions[t[0]])
-                                  .cross(mesh.positions[t[2]] - mesh.positions[t[0]]);
-    for (int c = 0; c < 3; ++c) sum[group[t[c]]] += face;
+    if (!unit_normal(t).allFinite()) continue;
+    for (int c = 0; c < 3; ++c) ++f.first[f.group[t[c]] + 1];
   }
-  std::vector<meshes::Vec3> dirs(mesh.vertex_count());
-  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-    const meshes::Vec3 d = sum[group[v]].normalized();
-    // Keep the origin above the vertex's own surface; fall back where the faces at a
-    // position nearly cancel (a thin fin).
-    dirs[v] = d.allFinite() && d.dot(mesh.normals[v]) > 0.2f ? d : mesh.normals[v];
+  for (std::size_t g = 0; g < group_of.size(); ++g) f.first[g + 1] += f.first[g];
+  std::vector<std::uint32_t> fill(f.first.begin(), f.first.end() - 1);
+  f.normals.resize(3, f.first.back());
+  f.steps.resize(3, f.first.back());
+  for (const meshes::Triangle& t : mesh.triangles) {
+    const meshes::Vec3 n = unit_normal(t);
+    if (!n.allFinite()) continue;
+    const meshes::Vec3 centroid =
+        (mesh.positions[t[0]] + mesh.positions[t[1]] + mesh.positions[t[2]]) / 3.f;
+    for (int c = 0; c < 3; ++c) {
+      const meshes::Vec3 inward = centroid - mesh.positions[t[c]];
+      // Half the way to the centroid at most, so the start point stays on a small face.
+      const float step = std::min(kStep * offset, 0.5f * inward.norm());
+      const std::uint32_t e = fill[f.group[t[c]]]++;
+      f.normals.col(e) = n;
+      f.steps.col(e) = step * (inward.normalized() + kLift * n);
+    }
   }
-  return dirs;
+  return f;
 }
 
 Setup make_setup(const BakeOptions& o, int channels, double* brdf_seconds) {
@@ -252,7 +287,7 @@ struct BakeContext {
   int channels = 0;
   bool glossy = false;
   float offset = 0;  // ray-origin offset in world units
-  std::vector<meshes::Vec3> offset_dirs;
+  OriginFaces faces;
   std::uint64_t vertex_count = 0, chunks = 0;
 };
 
@@ -269,6 +304,8 @@ struct ShadowScratch {
     diffuse_world.resize(n);
     for (int l = 0; l < order; ++l) bands.emplace_back(2 * l + 1, 2 * l + 1);
     occluded_world.resize(3, samples);
+    origins.resize(3, samples);
+    occluded_origins.resize(3, samples);
     hits.resize(samples);
   }
   Eigen::Matrix3Xf world;
@@ -280,6 +317,7 @@ struct ShadowScratch {
   ShRotation rotation;  // D of the current vertex's frame, rebuilt in place
   std::vector<MatF> bands;
   Eigen::Matrix3Xf occluded_world;
+  Eigen::Matrix3Xf origins, occluded_origins;  // per ray, for world and occluded_world
   std::vector<RayHit> hits;
   std::uint64_t rays_shadow = 0, rays_bounce = 0, occluded_count = 0;
 };
@@ -301,13 +339,36 @@ TransferSet empty_transfer(const meshes::Mesh& mesh, const BakeOptions& o, const
   return out;
 }
 
+// Start points of p's rays (s.world) into s.origins: each on the face at p's position whose
+// plane the ray rises most steeply above. A vertex on no face starts above itself.
+void ray_origins(const BakeContext& ctx, ShadowScratch& s, std::uint64_t p) {
+  const OriginFaces& f = ctx.faces;
+  const std::uint32_t g = f.group[p], begin = f.first[g], end = f.first[g + 1];
+  const meshes::Vec3& at = ctx.mesh.positions[p];
+  if (begin == end) {
+    s.origins.colwise() = at + ctx.offset * ctx.mesh.normals[p];
+    return;
+  }
+  for (Eigen::Index k = 0; k < s.world.cols(); ++k) {
+    const Eigen::Vector3f d = s.world.col(k);
+    std::uint32_t best = begin;
+    float best_rise = f.normals.col(begin).dot(d);
+    for (std::uint32_t e = begin + 1; e < end; ++e) {
+      const float rise = f.normals.col(e).dot(d);
+      if (rise > best_rise) best_rise = rise, best = e;
+    }
+    s.origins.col(k) = at + f.steps.col(best);
+  }
+}
+
 // Traces p's shadow rays; leaves the occluded directions in s.occluded_index and their SH
 // values in s.y_occluded, and returns how many there are.
-int trace_shadow_rays(const BakeContext& ctx, ShadowScratch& s, const Eigen::Matrix3f& frame,
-                      const Eigen::Vector3f& origin) {
+int trace_shadow_rays(const BakeContext& ctx, ShadowScratch& s, std::uint64_t p,
+                      const Eigen::Matrix3f& frame) {
   const Setup& setup = ctx.setup;
   s.world.noalias() = frame * setup.directions;
-  ctx.scene.occluded(origin, s.world, 0.f, s.occluded.data());
+  ray_origins(ctx, s, p);
+  ctx.scene.occluded_from(s.origins, s.world, 0.f, s.occluded.data());
   int k = 0;
   for (int d = 0; d < setup.samples; ++d) {
     if (!s.occluded[d]) continue;
@@ -357,11 +418,14 @@ void diffuse_shadow_transfer(const BakeContext& ctx, ShadowScratch& s, int k,
 }
 
 // Closest hits of p's k occluded rays, kept for every bounce; back faces send no light.
-void record_front_hits(const BakeContext& ctx, ShadowScratch& s, int k,
-                       const Eigen::Vector3f& origin, HitBlock& block) {
+void record_front_hits(const BakeContext& ctx, ShadowScratch& s, int k, HitBlock& block) {
   const meshes::Mesh& mesh = ctx.mesh;
-  for (int j = 0; j < k; ++j) s.occluded_world.col(j) = s.world.col(s.occluded_index[j]);
-  ctx.scene.intersect(origin, s.occluded_world.leftCols(k), 0.f, s.hits.data());
+  for (int j = 0; j < k; ++j) {
+    s.occluded_world.col(j) = s.world.col(s.occluded_index[j]);
+    s.occluded_origins.col(j) = s.origins.col(s.occluded_index[j]);
+  }
+  ctx.scene.intersect_from(s.occluded_origins.leftCols(k), s.occluded_world.leftCols(k), 0.f,
+                           s.hits.data());
   s.rays_bounce += k;
   for (int j = 0; j < k; ++j) {
     const RayHit& h = s.hits[j];
@@ -391,15 +455,14 @@ void shadow_pass(const BakeContext& ctx, ShadowPool& pool, std::vector<HitBlock>
     if (block) block->offsets.assign(1, 0);
     for (std::uint64_t p = begin; p < end; ++p) {
       const Eigen::Matrix3f frame = frame_of(ctx.mesh, p);
-      const Eigen::Vector3f origin = ctx.mesh.positions[p] + ctx.offset * ctx.offset_dirs[p];
-      const int k = trace_shadow_rays(ctx, s, frame, origin);
+      const int k = trace_shadow_rays(ctx, s, p, frame);
       nearly_occluded[p] = double(ctx.setup.samples - k) < visible_floor ? 1 : 0;
       if (ctx.glossy) {
         glossy_shadow_transfer(ctx, s, k, frame, out, p);
       } else {
         diffuse_shadow_transfer(ctx, s, k, frame, out, p);
       }
-      if (block) record_front_hits(ctx, s, k, origin, *block);
+      if (block) record_front_hits(ctx, s, k, *block);
     }
     progress.add(end - begin);
   });
@@ -539,7 +602,7 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
   ctx.channels = channels;
   ctx.glossy = o.kind == TransferKind::kGlossy;
   ctx.offset = static_cast<float>(o.ray_offset * meshes::bounds(mesh).diagonal());
-  ctx.offset_dirs = ray_offset_directions(mesh);
+  ctx.faces = origin_faces(mesh, ctx.offset);
   ctx.vertex_count = mesh.vertex_count();
   ctx.chunks = (ctx.vertex_count + kChunk - 1) / kChunk;
 

@@ -18,11 +18,14 @@
 //    Back-face hits occlude but bring nothing. The result is sum_b M_p^b.
 // Vertices are independent, so the output is bit-identical for any thread count.
 //
-// Rays start at p + offset o_p (offset relative to the bounding-box diagonal), where o_p is
-// the normalised sum of the normals of all triangles at p's position, across split vertices:
-// the vertex normal on a welded mesh, the bisector at a hard edge made of split vertices.
-// That clears the vertex's own triangles and any other face through p, and stays far below
-// the thickness of thin parts.
+// Ray origins. Each ray starts on the triangle at p's position (split vertices included)
+// whose plane it rises most steeply above: a point a small step from p into that triangle,
+// lifted slightly along its normal (the step scales with `ray_offset`). A single offset
+// point cannot serve every direction: at a pit, a fold or a thin fin the outside near p is
+// a narrow wedge, and the old offset along the summed face normals landed inside the closed
+// mesh there. Starting inside the face also keeps rays at a hard edge of split vertices from
+// slipping through the crease, and the bounce pass finds its hits from the same points.
+// Choice and measurements: docs/ARCHITECTURE.md, "Baking (prt/)".
 #pragma once
 
 #include "meshes/mesh.h"
@@ -50,7 +53,7 @@ struct BakeOptions {
   int bounces = 1;
   std::uint64_t seed = 1;
   Material material;
-  double ray_offset = 1e-4;  // times the bounding-box diagonal
+  double ray_offset = 1e-4;  // times the bounding-box diagonal; origins step a tenth of it
   // Glossy only: use this n x n matrix for every channel instead of the material's BRDF
   // matrix (a measured BRDF projected elsewhere; tests pass the identity to read T_p).
   // The file still records `material`.
