@@ -69,8 +69,9 @@ Runner add_bake_command(CLI::App& app) {
     std::printf("rays        %.1f M (%.1f M shadow, %.1f M bounce), %.1f M rays/s\n", rays / 1e6,
                 double(stats.rays_shadow) / 1e6, double(stats.rays_bounce) / 1e6,
                 rays / 1e6 / (stats.seconds_shadow + stats.seconds_bounces));
-    std::printf("occluded    %.1f%% of shadow rays; %zu vertices see < %g%% of their rays%s\n",
-                100.0 * stats.occluded_fraction, dark.size(), 100.0 * prt::kNearlyOccluded,
+    std::printf("occluded    %.1f%% of shadow rays; %zu %s with < %g%% of rays escaping%s\n",
+                100.0 * stats.occluded_fraction, dark.size(),
+                dark.size() == 1 ? "vertex" : "vertices", 100.0 * prt::kNearlyOccluded,
                 dark_list.c_str());
   };
 }
