@@ -25,6 +25,11 @@
 // a narrow wedge, and the old offset along the summed face normals landed inside the closed
 // mesh there. Starting inside the face also keeps rays at a hard edge of split vertices from
 // slipping through the crease, and the bounce pass finds its hits from the same points.
+// A start point can still be inside the body where a fold takes the vertex itself under a
+// neighbouring face. So a vertex whose rays are (nearly) all blocked is probed: if a short
+// ray from its start points leaves the body through a back face within 10 offsets, all its
+// rays (shadow and bounce) start again from one point just past that exit. Deeper than that
+// it is taken to be enclosed: it stays black and is reported.
 // Choice and measurements: docs/ARCHITECTURE.md, "Baking (prt/)".
 #pragma once
 
@@ -88,6 +93,10 @@ struct BakeStats {
   // Nearly occluded vertices, ascending. A sound surface rarely has any: they render black,
   // and point at enclosed or broken geometry (or rays that start inside the surface).
   std::vector<std::uint32_t> occluded_vertices;
+  // Nearly occluded vertices whose start points were found just inside a closed surface
+  // (a back face within 10 offsets) and whose rays were traced again from just past it,
+  // ascending. Those still nearly occluded afterwards are in occluded_vertices too.
+  std::vector<std::uint32_t> moved_origins;
 };
 
 // The mesh must have frames (meshes::compute_frames). Throws std::invalid_argument for bad
