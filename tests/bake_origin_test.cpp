@@ -301,8 +301,8 @@ meshes::Mesh folded_fin_box(float depth, std::uint32_t* v, std::uint32_t* over) 
 }
 
 TEST(BakeOrigin, VertexFoldedJustInsideSeesFromOutsideItsFace) {
-  // 2e-4 under the face: 0.6 of the default ray offset (1e-4 of the diagonal, 2 sqrt 3 here),
-  // the bunny's fold depth measured the same way.
+  // 2e-4 under the face: half the default ray offset (1e-4 of the diagonal, 3.77 here),
+  // about as deep as the bunny's fold (0.6 offsets).
   std::uint32_t v = 0, over = 0;
   const meshes::Mesh m = folded_fin_box(2e-4f, &v, &over);
   const Vec3d p = m.positions[v].cast<double>(), n = m.normals[v].cast<double>();
