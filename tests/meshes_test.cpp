@@ -938,3 +938,26 @@ TEST(Load, GlmarkHorse) {
   EXPECT_EQ(m.vertex_count(), 3582u);
   EXPECT_EQ(m.triangle_count(), 7172u);
 }
+
+TEST(Frames, FoldedBackSliversDoNotTurnTheNormalInward) {
+  // A fan at the origin: two faces of 30 degrees each facing +Y carry almost all the area;
+  // two slivers of 160 degrees each fold back under them, facing -Y, with 1e-4 of the area.
+  // By corner angle the slivers win 320 to 60 and the normal would point to -Y, away from
+  // almost all of the fan, as at a fold-back corner of a scanned mesh.
+  const double kDeg = std::numbers::pi / 180.0;
+  auto at = [&](double degrees, double radius) {
+    return Vec3(static_cast<float>(radius * std::cos(degrees * kDeg)), 0.f,
+                static_cast<float>(-radius * std::sin(degrees * kDeg)));
+  };
+  Mesh m;
+  m.positions = {Vec3::Zero(), at(0, 1),       at(30, 1),     at(60, 1),
+                 at(0, 0.01),  at(-160, 0.01), at(-320, 0.01)};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}, {0, 4, 5}, {0, 5, 6}};
+  for (std::size_t f = 0; f < 2; ++f) ASSERT_GT(face_normal(m, m.triangles[f]).y(), 0.f);
+  for (std::size_t f = 2; f < 4; ++f) ASSERT_LT(face_normal(m, m.triangles[f]).y(), 0.f);
+
+  meshes::compute_frames(m, meshes::NormalWeighting::kAngle);
+  EXPECT_GT(m.normals[0].y(), 0.9999f) << m.normals[0].transpose();
+  meshes::compute_frames(m, meshes::NormalWeighting::kArea);
+  EXPECT_GT(m.normals[0].y(), 0.9999f) << m.normals[0].transpose();
+}

@@ -59,7 +59,7 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
                   "Cook-Torrance Fresnel reflectance at normal incidence")
       ->capture_default_str();
   cmd->add_option("--ray-offset", f.bake.ray_offset,
-                  "Ray start offset along the normal, times the bounding-box diagonal")
+                  "Rays start a tenth of this x the bbox diagonal into the face they leave through")
       ->capture_default_str();
 }
 

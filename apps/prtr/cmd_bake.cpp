@@ -6,8 +6,10 @@
 #include "progress_bar.h"
 #include "prt/transfer_file.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace prtr_app {
 
@@ -15,7 +17,7 @@ Runner add_bake_command(CLI::App& app) {
   struct Options {
     std::string mesh, output;
     BakeFlags flags;
-    bool quiet = false;
+    bool quiet = false, json = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -24,14 +26,45 @@ Runner add_bake_command(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Transfer file to write (.prtx)")->required();
   add_bake_flags(cmd, opt->flags);
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress bar");
+  cmd->add_flag("--json", opt->json, "Print the summary as one JSON line instead");
 
   return [opt] {
     Options& o = *opt;
     const prt::BakeOptions options = resolve_bake_flags(o.flags);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     prt::BakeStats stats;
-    const prt::TransferSet set = run_bake(mesh, o.mesh, options, o.quiet, &stats);
+    const prt::TransferSet set = run_bake(mesh, o.mesh, options, o.quiet || o.json, &stats);
     prt::write_transfer(o.output, set);
+
+    // A sound closed or open surface rarely has a vertex that sees (almost) none of its sky,
+    // so these are named: they render black and usually point at broken geometry.
+    // Moved origins are named too: their vertex lies just inside the surface (a fold), which
+    // the bake worked around but the mesh still has.
+    auto ids = [](const std::vector<std::uint32_t>& v, std::string* json, std::string* text) {
+      for (std::size_t i = 0; i < std::min<std::size_t>(v.size(), 8); ++i) {
+        *json += (i ? "," : "") + std::to_string(v[i]);
+        *text += (i ? ", " : " (") + std::to_string(v[i]);
+      }
+      if (!v.empty()) *text += v.size() > 8 ? ", ...)" : ")";
+    };
+    const std::vector<std::uint32_t>& dark = stats.occluded_vertices;
+    const std::vector<std::uint32_t>& moved = stats.moved_origins;
+    std::string dark_ids, dark_list, moved_ids, moved_list;
+    ids(dark, &dark_ids, &dark_list);
+    ids(moved, &moved_ids, &moved_list);
+    if (o.json) {
+      std::printf(
+          "{\"vertices\":%zu,\"seconds_total\":%.4f,\"seconds_shadow\":%.4f,"
+          "\"seconds_bounces\":%.4f,\"seconds_brdf\":%.4f,\"rays_shadow\":%llu,"
+          "\"rays_bounce\":%llu,\"occluded_fraction\":%.6f,\"nearly_occluded_vertices\":%zu,"
+          "\"nearly_occluded_ids\":[%s],\"moved_origin_vertices\":%zu,"
+          "\"moved_origin_ids\":[%s]}\n",
+          mesh.vertex_count(), stats.seconds_total, stats.seconds_shadow, stats.seconds_bounces,
+          stats.seconds_brdf, (unsigned long long)stats.rays_shadow,
+          (unsigned long long)stats.rays_bounce, stats.occluded_fraction, dark.size(),
+          dark_ids.c_str(), moved.size(), moved_ids.c_str());
+      return;
+    }
 
     const double rays = double(stats.rays_shadow + stats.rays_bounce);
     std::printf("baked       %s -> %s\n", o.mesh.c_str(), o.output.c_str());
@@ -44,7 +77,11 @@ Runner add_bake_command(CLI::App& app) {
     std::printf("rays        %.1f M (%.1f M shadow, %.1f M bounce), %.1f M rays/s\n", rays / 1e6,
                 double(stats.rays_shadow) / 1e6, double(stats.rays_bounce) / 1e6,
                 rays / 1e6 / (stats.seconds_shadow + stats.seconds_bounces));
-    std::printf("occluded    %.1f%% of shadow rays\n", 100.0 * stats.occluded_fraction);
+    std::printf(
+        "occluded    %.1f%% of shadow rays; %zu %s with < %g%% of rays escaping%s; %zu moved "
+        "out from just inside the surface%s\n",
+        100.0 * stats.occluded_fraction, dark.size(), dark.size() == 1 ? "vertex" : "vertices",
+        100.0 * prt::kNearlyOccluded, dark_list.c_str(), moved.size(), moved_list.c_str());
   };
 }
 

@@ -7,6 +7,13 @@
 // them only where the normal is parallel to the reference axis, and the axis is chosen among
 // X, Y, Z as the one the normals avoid most (smallest sum of |n . axis|^8; the high power
 // makes the sum count the near-parallel normals, not the broad distribution).
+//
+// Angle weighting trusts a face's corner angle however small the face is. Where a sliver
+// folds back over its neighbours (a corner of 150+ degrees on a face of a few percent of
+// the fan's area), the slivers can outvote the rest and turn the normal inward, below the
+// plane of most of the fan. Such a vertex takes the area-weighted normal instead, which
+// maximises the area-weighted sum of n_f . n and so sides with the fan's bulk. On glmark2's
+// bunny no vertex qualifies; on its horse, one (docs/ARCHITECTURE.md).
 #include "meshes/frames.h"
 
 #include <array>
@@ -44,6 +51,30 @@ Vec3d tangent_from_reference_d(const Vec3d& n, const Vec3d& reference) {
   return t.normalized();
 }
 
+// Replaces each angle-weighted sum in `sums` by the vertex's area-weighted sum where more
+// than half of the vertex's incident area faces away from the angle-weighted direction.
+void fall_back_where_inward(const Mesh& mesh, const std::vector<Vec3d>& area_sums,
+                            std::vector<Vec3d>& sums) {
+  const std::size_t n = sums.size();
+  std::vector<Vec3d> directions(n);
+  for (std::size_t v = 0; v < n; ++v) directions[v] = sums[v].normalized();
+  std::vector<double> total(n, 0.0), below(n, 0.0);
+  for (const Triangle& tri : mesh.triangles) {
+    const Vec3d p0 = mesh.positions[tri[0]].cast<double>();
+    const Vec3d cross = (mesh.positions[tri[1]].cast<double>() - p0)
+                            .cross(mesh.positions[tri[2]].cast<double>() - p0);
+    const double len = cross.norm();
+    if (!(len > 0.0)) continue;
+    for (std::uint32_t v : tri) {
+      total[v] += len;
+      if (cross.dot(directions[v]) < 0.0) below[v] += len;
+    }
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    if (below[v] > 0.5 * total[v] && area_sums[v].norm() > 0.0) sums[v] = area_sums[v];
+  }
+}
+
 }  // namespace
 
 Vec3 tangent_from_reference(const Vec3& n, const Vec3& reference) {
@@ -56,6 +87,7 @@ Vec3 tangent_from_reference(const Vec3& n, const Vec3& reference) {
 void compute_frames(Mesh& mesh, NormalWeighting weighting) {
   const std::size_t n = mesh.positions.size();
   std::vector<Vec3d> sums(n, Vec3d::Zero());
+  std::vector<Vec3d> area_sums(n, Vec3d::Zero());
   std::vector<bool> touched(n, false);
 
   for (const Triangle& tri : mesh.triangles) {
@@ -66,10 +98,8 @@ void compute_frames(Mesh& mesh, NormalWeighting weighting) {
     const double len = cross.norm();
     for (std::uint32_t v : tri) touched[v] = true;
     if (!(len > 0.0)) continue;  // a zero-area face has no normal to contribute
-    if (weighting == NormalWeighting::kArea) {
-      for (std::uint32_t v : tri) sums[v] += cross;  // |cross| = twice the area
-      continue;
-    }
+    for (std::uint32_t v : tri) area_sums[v] += cross;  // |cross| = twice the area
+    if (weighting == NormalWeighting::kArea) continue;
     const Vec3d unit = cross / len;
     for (int c = 0; c < 3; ++c) {
       const Vec3d e1 = p[(c + 1) % 3] - p[c];
@@ -77,6 +107,12 @@ void compute_frames(Mesh& mesh, NormalWeighting weighting) {
       const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
       sums[tri[c]] += angle * unit;
     }
+  }
+
+  if (weighting == NormalWeighting::kAngle) {
+    fall_back_where_inward(mesh, area_sums, sums);
+  } else {
+    sums.swap(area_sums);
   }
 
   // Normals; vertices without a face (or whose faces cancel) get +Y.

@@ -1,6 +1,8 @@
 // meshes/frames.h: per-vertex normals and tangent frames.
 //
-// Normals are the weighted sum of incident face normals (by corner angle or face area).
+// Normals are the weighted sum of incident face normals (by corner angle or face area;
+// angle weighting falls back to area weighting where it would turn a vertex's normal away
+// from most of its incident area).
 // Tangents follow one global reference axis projected into each tangent plane, so the frame
 // field is continuous wherever the surface is, except at the (unavoidable, hairy-ball) points
 // where the normal is parallel to the reference axis. The axis is chosen per mesh among

@@ -18,11 +18,19 @@
 //    Back-face hits occlude but bring nothing. The result is sum_b M_p^b.
 // Vertices are independent, so the output is bit-identical for any thread count.
 //
-// Rays start at p + offset o_p (offset relative to the bounding-box diagonal), where o_p is
-// the normalised sum of the normals of all triangles at p's position, across split vertices:
-// the vertex normal on a welded mesh, the bisector at a hard edge made of split vertices.
-// That clears the vertex's own triangles and any other face through p, and stays far below
-// the thickness of thin parts.
+// Ray origins. Each ray starts on the triangle at p's position (split vertices included)
+// whose plane it rises most steeply above: a point a small step from p into that triangle,
+// lifted slightly along its normal (the step scales with `ray_offset`). A single offset
+// point cannot serve every direction: at a pit, a fold or a thin fin the outside near p is
+// a narrow wedge, and the old offset along the summed face normals landed inside the closed
+// mesh there. Starting inside the face also keeps rays at a hard edge of split vertices from
+// slipping through the crease, and the bounce pass finds its hits from the same points.
+// A start point can still be inside the body where a fold takes the vertex itself under a
+// neighbouring face. So a vertex whose rays are (nearly) all blocked is probed: if a short
+// ray from its start points leaves the body through a back face within 10 offsets, all its
+// rays (shadow and bounce) start again from one point just past that exit. Deeper than that
+// it is taken to be enclosed: it stays black and is reported.
+// Choice and measurements: docs/ARCHITECTURE.md, "Baking (prt/)".
 #pragma once
 
 #include "meshes/mesh.h"
@@ -33,6 +41,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace prt {
 
@@ -49,7 +58,7 @@ struct BakeOptions {
   int bounces = 1;
   std::uint64_t seed = 1;
   Material material;
-  double ray_offset = 1e-4;  // times the bounding-box diagonal
+  double ray_offset = 1e-4;  // times the bounding-box diagonal; origins step a tenth of it
   // Glossy only: use this n x n matrix for every channel instead of the material's BRDF
   // matrix (a measured BRDF projected elsewhere; tests pass the identity to read T_p).
   // The file still records `material`.
@@ -74,10 +83,20 @@ BakeEstimate estimate_bake(const meshes::Mesh& mesh, const BakeOptions& options)
 // Bytes of memory available now (MemAvailable in /proc/meminfo), 0 if unknown.
 std::uint64_t available_memory();
 
+// A vertex is nearly occluded when less than this share of its shadow rays escapes.
+inline constexpr double kNearlyOccluded = 0.01;
+
 struct BakeStats {
   double seconds_shadow = 0, seconds_bounces = 0, seconds_brdf = 0, seconds_total = 0;
   std::uint64_t rays_shadow = 0, rays_bounce = 0;
   double occluded_fraction = 0;
+  // Nearly occluded vertices, ascending. A sound surface rarely has any: they render black,
+  // and point at enclosed or broken geometry (or rays that start inside the surface).
+  std::vector<std::uint32_t> occluded_vertices;
+  // Nearly occluded vertices whose start points were found just inside a closed surface
+  // (a back face within 10 offsets) and whose rays were traced again from just past it,
+  // ascending. Those still nearly occluded afterwards are in occluded_vertices too.
+  std::vector<std::uint32_t> moved_origins;
 };
 
 // The mesh must have frames (meshes::compute_frames). Throws std::invalid_argument for bad

@@ -1,7 +1,7 @@
 // prt/ray_scene.h: ray queries against a mesh, through Embree 3 (kept out of this header).
 //
-// Rays are given as one origin and a structure-of-arrays list of directions, which is what
-// the baker has: every vertex shoots its whole sample set from one point. Queries are
+// Rays are given as structure-of-arrays lists of directions with either one shared origin or
+// one origin per ray (the baker starts each ray on the face it leaves through). Queries are
 // const and thread-safe; call them from many threads at once.
 #pragma once
 
@@ -44,6 +44,14 @@ class RayScene {
   void intersect(const Eigen::Vector3f& origin,
                  const Eigen::Ref<const Eigen::Matrix3Xf>& directions, float tnear,
                  RayHit* hits) const;
+
+  // The same with one origin per ray: `origins` is 3 x count, like `directions`.
+  void occluded_from(const Eigen::Ref<const Eigen::Matrix3Xf>& origins,
+                     const Eigen::Ref<const Eigen::Matrix3Xf>& directions, float tnear,
+                     std::uint8_t* occluded) const;
+  void intersect_from(const Eigen::Ref<const Eigen::Matrix3Xf>& origins,
+                      const Eigen::Ref<const Eigen::Matrix3Xf>& directions, float tnear,
+                      RayHit* hits) const;
 
  private:
   struct Impl;
