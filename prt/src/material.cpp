@@ -12,6 +12,8 @@
 // its own partial B; the partials are summed in chunk order, so the result is deterministic.
 #include "prt/material.h"
 
+#include "common/enum_names.h"
+
 #include "prt/sh.h"
 #include "prt/zonal.h"
 
@@ -222,25 +224,19 @@ void Material::validate() const {
   }
 }
 
+namespace {
+constexpr common::EnumName<MaterialKind> kMaterialNames[] = {
+    {MaterialKind::kLambert, "lambert"},
+    {MaterialKind::kPhong, "phong"},
+    {MaterialKind::kCookTorrance, "cook-torrance"}};
+}  // namespace
+
 const char* material_name(MaterialKind kind) {
-  switch (kind) {
-    case MaterialKind::kLambert:
-      return "lambert";
-    case MaterialKind::kPhong:
-      return "phong";
-    case MaterialKind::kCookTorrance:
-      return "cook-torrance";
-  }
-  return "unknown";
+  return common::enum_name<MaterialKind>(kMaterialNames, kind);
 }
 
 MaterialKind parse_material(const std::string& name) {
-  for (MaterialKind kind :
-       {MaterialKind::kLambert, MaterialKind::kPhong, MaterialKind::kCookTorrance}) {
-    if (name == material_name(kind)) return kind;
-  }
-  throw std::invalid_argument("unknown material '" + name +
-                              "' (valid: lambert, phong, cook-torrance)");
+  return common::parse_enum<MaterialKind>(kMaterialNames, name, "material");
 }
 
 double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,

@@ -1,15 +1,15 @@
 #include "prt/transfer.h"
 
+#include "common/enum_names.h"
+
 namespace prt {
+namespace {
+constexpr common::EnumName<TransferKind> kKindNames[] = {{TransferKind::kDiffuse, "diffuse"},
+                                                         {TransferKind::kGlossy, "glossy"}};
+}  // namespace
 
 const char* transfer_kind_name(TransferKind kind) {
-  switch (kind) {
-    case TransferKind::kDiffuse:
-      return "diffuse";
-    case TransferKind::kGlossy:
-      return "glossy";
-  }
-  return "unknown";  // only reachable through a cast of an out-of-range integer
+  return common::enum_name<TransferKind>(kKindNames, kind);
 }
 
 }  // namespace prt

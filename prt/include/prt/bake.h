@@ -1,5 +1,5 @@
 // prt/bake.h: per-vertex SH transfer by ray tracing (Embree): a shadow pass, then
-// interreflection passes. Thesis ch. 3.1.1 (eq. 1-3) and DESIGN.md "The math".
+// interreflection passes. Thesis ch. 3.1.1 (eq. 1-3); conventions in docs/ARCHITECTURE.md.
 //
 // Method. Every vertex uses the same hemisphere direction set D (prt/sampling.h) expressed
 // in its local frame F_p = [t b n], so the SH values Y (n x S) of those directions are
@@ -9,7 +9,7 @@
 //                                    = w Y Y^T - w Y_O Y_O^T,
 //    so a vertex costs work in proportion to its occluded rays (a symmetric rank-k update);
 //  - glossy exit transfer:       M_p = B T_p D(F_p^T)   (B: prt/material.h; D: sh_rotation.h)
-//    which equals DESIGN.md's B D(F_p^T) T_p(world) with T_p expressed in the local frame;
+//    which equals B D(F_p^T) T_p(world) with T_p expressed in the local frame;
 //  - diffuse transfer:           t_p = D(F_p) (rho/pi) w sum_{s visible} s_z y(s);
 //  - bounce b >= 1: an occluded ray that hits the front of triangle (q0, q1, q2) at
 //    barycentrics (u, v) brings r = sum_c beta_c y(F_c^T (-s))^T M_c^{b-1} (glossy) or
