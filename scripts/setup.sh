@@ -7,8 +7,9 @@
 # The list is what a pristine Debian 12 root needs, proven by .ci/run on every submission.
 # openimageio-tools looks optional but is not: Debian's OpenImageIO CMake config declares
 # imported targets for its command-line tools, and find_package fails when they are absent.
-# python3-matplotlib (the plot of prtr overdraw, scripts/plot_overdraw.py) is run, not
-# linked: without it prtr still works and says how to get the plot, but its test is skipped.
+# ffmpeg (the MP4 of prtr relight, and ffprobe for its test) and python3-matplotlib (the plot
+# of prtr overdraw, scripts/plot_overdraw.py) are run, not linked: without them prtr still
+# works and says how to get the missing output, but the tests that check it are skipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,7 +18,7 @@ packages=(
   libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
   libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
-  python3-matplotlib
+  ffmpeg python3-matplotlib
   glmark2-data blender-data
 )
 

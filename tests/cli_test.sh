@@ -2,8 +2,8 @@
 # End-to-end tests of the prtr binary: exit codes (0 ok, 1 failure, 2 usage), error messages
 # that name the input, and values parsed from the output (a pattern that matches nothing is
 # a failure, never a pass). JSON is parsed by json_check (nlohmann, as prtr writes it); the
-# plot script is checked when python3-matplotlib is installed, as scripts/setup.sh does, and
-# reported as SKIP otherwise.
+# plot script and the MP4 are checked when python3-matplotlib and ffmpeg are installed, as
+# scripts/setup.sh does, and reported as SKIP otherwise.
 # Usage: cli_test.sh PRTR TMPDIR JSON_CHECK PLOT_SCRIPT
 set -u
 prtr=$1
@@ -24,6 +24,11 @@ expect_code() { [[ $code == "$1" ]]; }
 skip() { echo "SKIP: $1"; }
 # jget FILE|- POINTER: the value at a JSON pointer (strings unquoted); fails on invalid JSON.
 jget() { "$json_check" "$@"; }
+# media_info FILE: "width,height,frames" of the first video stream, decoded by ffprobe.
+media_info() {
+  ffprobe -v error -count_frames -select_streams v:0 \
+    -show_entries stream=width,height,nb_read_frames -of csv=p=0 "$1" 2>/dev/null
+}
 have_matplotlib() { /usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1; }
 
 # Usage.
@@ -183,8 +188,17 @@ fi
 if [[ -f $forest ]]; then
   rl=(relight "$tmp/cube.obj" --probe "$forest" --order 2 --samples 32 --bounces 0 --clusters 2
       --pcs 2 --frames 3 --width 64 --height 32 --background black --cache "$tmp/rl_cache"
-      --out "$tmp/rl" --no-video -q)
+      --out "$tmp/rl" -q)
   run "${rl[@]}"; expect_code 0; check "relight: exits 0 ($err)" $?
+  # The animations, decoded by another program than the one that wrote them.
+  if command -v ffprobe >/dev/null; then
+    info=$(media_info "$tmp/rl/relight.gif"); [[ $info == 64,32,3 ]]; check "relight: GIF is 64 x 32, 3 frames ($info)" $?
+    info=$(media_info "$tmp/rl/relight.mp4"); [[ $info == 64,32,3 ]]; check "relight: MP4 is 64 x 32, 3 frames ($info)" $?
+  else
+    skip "relight animations decoded (ffmpeg is not installed)"
+    [[ $(head -c 6 "$tmp/rl/relight.gif") == GIF89a && $out == *"apt-get install ffmpeg"* ]]; check "relight: GIF without ffmpeg, and how to get the MP4" $?
+  fi
+  [[ -z $(find "$tmp/rl" -name '.*tmp-*') ]]; check "relight: no temporary files left" $?
   [[ $out == *"bake        baked"* && $out == *"compress    compressed"* ]]; check "relight: first run bakes and compresses" $?
   [[ $out =~ contact\ sheet:\ (.*contact_sheet.png) && -s ${BASH_REMATCH[1]} ]]; check "relight: prints the contact sheet's path" $?
   [[ $(head -c 8 "$tmp/rl/contact_sheet.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]]; check "relight: contact sheet is a PNG" $?
