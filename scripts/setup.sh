@@ -7,6 +7,9 @@
 # The list is what a pristine Debian 12 root needs, proven by .ci/run on every submission.
 # openimageio-tools looks optional but is not: Debian's OpenImageIO CMake config declares
 # imported targets for its command-line tools, and find_package fails when they are absent.
+# ffmpeg (the MP4 of prtr relight, and ffprobe for its test) and python3-matplotlib (the plot
+# of prtr overdraw, scripts/plot_overdraw.py) are run, not linked: without them prtr still
+# works and says how to get the missing output, but the tests that check it are skipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -14,7 +17,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
   libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
-  libmetis-dev libmeshoptimizer-dev
+  libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
+  ffmpeg python3-matplotlib
   glmark2-data blender-data
 )
 

@@ -1,10 +1,15 @@
 #!/usr/bin/env bash
 # End-to-end tests of the prtr binary: exit codes (0 ok, 1 failure, 2 usage), error messages
 # that name the input, and values parsed from the output (a pattern that matches nothing is
-# a failure, never a pass).
+# a failure, never a pass). JSON is parsed by json_check (nlohmann, as prtr writes it); the
+# plot script and the MP4 are checked when python3-matplotlib and ffmpeg are installed, as
+# scripts/setup.sh does, and reported as SKIP otherwise.
+# Usage: cli_test.sh PRTR TMPDIR JSON_CHECK PLOT_SCRIPT
 set -u
 prtr=$1
 tmp=$2
+json_check=$3
+plot_script=$4
 rm -rf "$tmp" && mkdir -p "$tmp"
 passed=0
 failed=0
@@ -16,6 +21,15 @@ run() {  # run ARGS...: sets out, err, code
   out=$("$prtr" "$@" 2>"$tmp/err"); code=$?; err=$(cat "$tmp/err")
 }
 expect_code() { [[ $code == "$1" ]]; }
+skip() { echo "SKIP: $1"; }
+# jget FILE|- POINTER: the value at a JSON pointer (strings unquoted); fails on invalid JSON.
+jget() { "$json_check" "$@"; }
+# media_info FILE: "width,height,frames" of the first video stream, decoded by ffprobe.
+media_info() {
+  ffprobe -v error -count_frames -select_streams v:0 \
+    -show_entries stream=width,height,nb_read_frames -of csv=p=0 "$1" 2>/dev/null
+}
+have_matplotlib() { /usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1; }
 
 # Usage.
 run --help; expect_code 0; check "--help exits 0" $?
@@ -91,8 +105,9 @@ expect_code 0; check "compress exits 0" $?
 [[ $out =~ clusters\ 2\ x\ 2\ PCs ]]; check "compress reports clusters x PCs" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/cube8.prtc" --clusters 8 --pcs 1 --json -q
 # One vertex per cluster reconstructs exactly and the energy is summed in double, so the
-# error is exactly zero (%.9g prints 0), not merely small.
-[[ $out == *'"average_se":0,'* && $out == *'"relative_error":0,'* ]]; check "compress: clusters = vertices gives exactly zero error ($out)" $?
+# error is exactly zero, not merely small.
+errors=$(jget - /average_se /relative_error /clusters /method <<<"$out" | tr '\n' ' ')
+[[ $errors == "0.0 0.0 8 "* ]]; check "compress --json parses: clusters = vertices gives exactly zero error ($errors)" $?
 run info "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --transfer "$tmp/cube.prtx" --verify
 expect_code 0 && [[ $out == *current* && $out != *STALE* ]]; check "info: .prtc current against its mesh and bake" $?
 run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: .prtc stale against another mesh" $?
@@ -142,10 +157,24 @@ if [[ -f $forest ]]; then
   [[ $out == *"4 clusters, thesis budget"* && $out == *"4 clusters, default budget"* ]]; check "overdraw: both budgets tabled" $?
   rows=$(($(wc -l <"$tmp/od/overdraw.csv") - 1))
   [[ $rows == 16 ]]; check "overdraw: 2 K x 2 methods x 2 budgets x 2 strategies CSV rows (got $rows)" $?
-  [[ $(head -c 1 "$tmp/od/overdraw.json") == "{" ]] && grep -q '"rows":\[{' "$tmp/od/overdraw.json"; check "overdraw: JSON with rows" $?
-  for f in overdraw-plot.png clusters-K4-original.png clusters-K4-both.png; do
+  [[ $(jget "$tmp/od/overdraw.json" /rows/15/strategy /modes/0/mode | tr '\n' ' ') == "ils "* ]]; check "overdraw: overdraw.json parses, 16 rows" $?
+  for f in clusters-K4-original.png clusters-K4-both.png; do
     [[ -s $tmp/od/$f ]]; check "overdraw: wrote $f" $?
   done
+  if have_matplotlib; then
+    [[ $out == *"plot $tmp/od/overdraw-plot.png"* ]]; check "overdraw: runs the plot script" $?
+    [[ $(head -c 8 "$tmp/od/overdraw-plot.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]]; check "overdraw: the plot is a PNG" $?
+    rm -f "$tmp/od/by-hand.png"
+    /usr/bin/python3 "$plot_script" "$tmp/od/overdraw.json" -o "$tmp/od/by-hand.png" --budget default >/dev/null
+    [[ $? == 0 && -s $tmp/od/by-hand.png ]]; check "plot_overdraw.py: plots the JSON, default budget" $?
+    /usr/bin/python3 "$plot_script" "$tmp/od/overdraw.csv" --budget none 2>"$tmp/err"
+    [[ $? == 1 && $(cat "$tmp/err") == *"no rows for budget 'none'"* ]]; check "plot_overdraw.py: a budget without rows exits 1 naming it" $?
+    /usr/bin/python3 "$plot_script" 2>/dev/null; [[ $? == 2 ]]; check "plot_overdraw.py: no input is a usage error" $?
+  else
+    skip "overdraw plot (python3-matplotlib is not installed)"
+    [[ $out == *"apt-get install python3-matplotlib"* ]]; check "overdraw: says how to get the plot" $?
+  fi
+  run "${od[@]}" --json; expect_code 0 && [[ $(jget - /rows/0/clusters <<<"$out") == 2 ]]; check "overdraw --json: stdout parses" $?
   ls "$tmp"/od/overdraw-K4-original-*-thesis.png >/dev/null 2>&1; check "overdraw: wrote the K=4 overdraw picture" $?
   run "${od[@]}"; expect_code 0 && [[ $out == *"(cached: "* && $out == *"came from the cache"* ]]; check "overdraw: second run uses the cached bake and compressions" $?
   run overdraw "$tmp/cube.obj" --probe "$forest" --rows bogus; expect_code 2 && [[ $err == *--rows* ]]; check "overdraw: unknown row is a usage error" $?
@@ -159,8 +188,17 @@ fi
 if [[ -f $forest ]]; then
   rl=(relight "$tmp/cube.obj" --probe "$forest" --order 2 --samples 32 --bounces 0 --clusters 2
       --pcs 2 --frames 3 --width 64 --height 32 --background black --cache "$tmp/rl_cache"
-      --out "$tmp/rl" --no-video -q)
+      --out "$tmp/rl" -q)
   run "${rl[@]}"; expect_code 0; check "relight: exits 0 ($err)" $?
+  # The animations, decoded by another program than the one that wrote them.
+  if command -v ffprobe >/dev/null; then
+    info=$(media_info "$tmp/rl/relight.gif"); [[ $info == 64,32,3 ]]; check "relight: GIF is 64 x 32, 3 frames ($info)" $?
+    info=$(media_info "$tmp/rl/relight.mp4"); [[ $info == 64,32,3 ]]; check "relight: MP4 is 64 x 32, 3 frames ($info)" $?
+  else
+    skip "relight animations decoded (ffmpeg is not installed)"
+    [[ $(head -c 6 "$tmp/rl/relight.gif") == GIF89a && $out == *"apt-get install ffmpeg"* ]]; check "relight: GIF without ffmpeg, and how to get the MP4" $?
+  fi
+  [[ -z $(find "$tmp/rl" -name '.*tmp-*') ]]; check "relight: no temporary files left" $?
   [[ $out == *"bake        baked"* && $out == *"compress    compressed"* ]]; check "relight: first run bakes and compresses" $?
   [[ $out =~ contact\ sheet:\ (.*contact_sheet.png) && -s ${BASH_REMATCH[1]} ]]; check "relight: prints the contact sheet's path" $?
   [[ $(head -c 8 "$tmp/rl/contact_sheet.png" | od -An -tx1 | tr -d ' \n') == 89504e470d0a1a0a ]]; check "relight: contact sheet is a PNG" $?
@@ -181,6 +219,27 @@ if [[ -f $forest ]]; then
   run relight "$tmp/cube.obj" --probe "$forest" --order 0; expect_code 2; check "relight: order 0 is a usage error" $?
   run relight "$tmp/cube.obj" --probe "$forest" --order 11; expect_code 2; check "relight: order 11 is a usage error" $?
   run relight "$tmp/cube.obj" --probe "$forest" --axis 0,0,0; expect_code 2 && [[ $err == *--axis* ]]; check "relight: zero axis is a usage error" $?
+fi
+
+# JSON from every --json output, with names no JSON writer may pass through raw: a quote, a
+# backslash, a newline and a control character in every path, and bytes that are not UTF-8
+# in the probe's name (each becomes U+FFFD). Not in the mesh's: .prtc files record the mesh
+# path and refuse what is not UTF-8.
+if [[ -f $forest ]]; then
+  hostile=$'ho"st\\ile\n\x01'
+  dir="$tmp/$hostile"
+  mkdir -p "$dir"
+  cp "$tmp/cube.obj" "$dir/m$hostile.obj"
+  cp "$tmp/cube.prtx" "$dir/m$hostile.prtx"
+  probe="$dir/p$hostile"$'\xff\xfe.exr'
+  cp "$forest" "$probe"
+  run compress "$dir/m$hostile.prtx" --mesh "$dir/m$hostile.obj" -o "$dir/c$hostile.prtc" --clusters 2 --pcs 2 --json -q
+  expect_code 0 && jget - /clusters <<<"$out" >/dev/null; check "hostile names: compress --json parses ($err)" $?
+  run render "$dir/c$hostile.prtc" --mesh "$dir/m$hostile.obj" --probe "$probe" -o "$dir/r$hostile.exr" --width 32 --height 24 --frames 2 --warmup 0 --json -q
+  expect_code 0 && [[ $(jget - /mode /width <<<"$out" | tr '\n' ' ') == "multipass 32 " ]]; check "hostile names: render --json parses ($err)" $?
+  run overdraw "$dir/m$hostile.obj" --probe "$probe" --order 2 --samples 16 --bounces 0 --clusters 2 --pcs 2 --rows original --strategies order --budgets thesis --no-modes --frames 1 --warmup 0 --width 32 --height 24 --cache "$dir/cache" --out "$dir/od" --json -q
+  expect_code 0 && [[ $(jget - /mesh <<<"$out") == "$dir/m$hostile.obj" ]]; check "hostile names: overdraw --json parses, names intact ($err)" $?
+  [[ $(jget "$dir/od/overdraw.json" /probe) == "$dir/p$hostile"$'\xef\xbf\xbd\xef\xbf\xbd.exr' ]]; check "hostile names: overdraw.json parses, invalid bytes replaced" $?
 fi
 
 # Floating-point flags refuse NaN and infinity where they are parsed (CLI::Range alone lets

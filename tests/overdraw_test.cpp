@@ -12,6 +12,7 @@
 #include "test_support.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -258,7 +259,7 @@ TEST(FalseColour, PngKeepsColoursByteForByte) {
 
 // --- Report ----------------------------------------------------------------------------------
 
-TEST(OverdrawReport, TablesCsvJsonAndPlotCarryEveryRow) {
+TEST(OverdrawReport, TablesCsvAndJsonCarryEveryRow) {
   prtr_app::OverdrawReport r;
   r.mesh = "m.obj";
   r.triangles = 100;
@@ -274,26 +275,46 @@ TEST(OverdrawReport, TablesCsvJsonAndPlotCarryEveryRow) {
         row.clustering_seconds = 233;
         r.rows.push_back(row);
       }
+  r.modes.push_back({64, "singlepass", std::nan(""), 1.0, 0.0, 0.0});
   const std::string md = prtr_app::markdown(r);
   EXPECT_NE(md.find("### 64 clusters, thesis budget"), std::string::npos);
   EXPECT_NE(md.find("| original | ils | 3 m 53 s | 1.125000 |"), std::string::npos) << md;
   const std::string table = prtr_app::csv(r);
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 1 + 8);
-  const std::string js = prtr_app::json(r);
-  EXPECT_EQ(js.front(), '{');
-  EXPECT_NE(js.find("\"average_overdraw\":1.25,"), std::string::npos) << js;
-  const render::Picture plot = prtr_app::overdraw_plot(r, "thesis", 400, 300);
-  EXPECT_EQ(plot.width, 400);
-  // The method lines use cluster_colour(method index): both appear somewhere.
-  for (std::uint32_t m = 0; m < 2; ++m) {
-    bool found = false;
-    for (int y = 0; y < plot.height && !found; ++y)
-      for (int x = 0; x < plot.width && !found; ++x)
-        found = plot.at(x, y) == render::cluster_colour(m);
-    EXPECT_TRUE(found) << "method " << m;
-  }
-  EXPECT_THROW(prtr_app::overdraw_plot(r, "default"), std::invalid_argument);
+  const nlohmann::json js = nlohmann::json::parse(prtr_app::json(r));
+  ASSERT_EQ(js.at("rows").size(), 8u);
+  // Row 5 is K = 128, original, ils: 1 + 128/512 exactly.
+  EXPECT_EQ(js.at("rows").at(5).at("average_overdraw").get<double>(), 1.25);
+  EXPECT_EQ(js.at("rows").at(5).at("method").get<std::string>(), "original");
+  EXPECT_EQ(js.at("rows").at(5).at("strategy").get<std::string>(), "ils");
+  // Not a number has no JSON spelling: it is written as null, as before the library.
+  EXPECT_TRUE(js.at("modes").at(0).at("fps").is_null());
   EXPECT_EQ(prtr_app::format_duration(12.44), "12.4 s");
+}
+
+// Every string field carries a file name or a GL string the user does not control: quotes,
+// backslashes, control characters and bytes that are not UTF-8 must still give valid JSON.
+TEST(OverdrawReport, JsonSurvivesHostileStrings) {
+  const std::string hostile = std::string(
+                                  "a\"b\\c\n\t\x01"
+                                  "d") +
+                              "\xff\xfe" + "\xc3(" + "\xe9t\xc3\xa9";
+  prtr_app::OverdrawReport r;
+  r.mesh = r.probe = r.transfer = r.bake = r.gl_renderer = hostile;
+  prtr_app::OverdrawRow row;
+  row.method = row.budget = row.strategy = hostile;
+  r.rows.push_back(row);
+  r.modes.push_back({1, hostile, 1.0, 1.0, 0.0, 0.0});
+  nlohmann::json js;
+  ASSERT_NO_THROW(js = nlohmann::json::parse(prtr_app::json(r)));
+  // The valid parts survive byte for byte; each invalid byte becomes U+FFFD.
+  const std::string replaced =
+      "a\"b\\c\n\t\x01"
+      "d\xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd(\xef\xbf\xbdt\xc3\xa9";
+  for (const char* key : {"mesh", "probe", "transfer", "bake", "gl_renderer"})
+    EXPECT_EQ(js.at(key).get<std::string>(), replaced) << key;
+  EXPECT_EQ(js.at("rows").at(0).at("strategy").get<std::string>(), replaced);
+  EXPECT_EQ(js.at("modes").at(0).at("mode").get<std::string>(), replaced);
 }
 
 }  // namespace

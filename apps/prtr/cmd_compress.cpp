@@ -2,6 +2,7 @@
 // optional geometry coherence and overdraw-aware reassignment), with a one-screen report.
 #include "commands.h"
 #include "compress_flags.h"
+#include "json_output.h"
 
 #include "cpca/compress.h"
 #include "cpca/compressed_file.h"
@@ -44,22 +45,31 @@ void check_sizes(const cpca::CompressOptions& c, const Options& o) {
 void print_json(const cpca::CompressedSet& set, const cpca::CompressReport& report,
                 const Sizes& sizes) {
   const cpca::TriangleSpan& s = report.span;
-  std::printf(
-      "{\"clusters\":%d,\"pcs\":%d,\"method\":\"%s\",\"pca\":\"%s\",\"alpha\":%g,"
-      "\"overdraw_reduction\":%s,\"lbg_iterations\":%d,\"cpca_iterations\":%d,\"splits\":%d,"
-      "\"lbg_seconds\":%.4f,\"pca_seconds\":%.4f,\"cpca_seconds\":%.4f,"
-      "\"overdraw_seconds\":%.4f,\"clustering_seconds\":%.4f,\"total_seconds\":%.4f,"
-      "\"average_se\":%.9g,\"relative_error\":%.9g,\"max_se\":%.9g,\"ratio\":%.4f,"
-      "\"file_bytes\":%.0f,\"triangles_1\":%llu,\"triangles_2\":%llu,\"triangles_3\":%llu,"
-      "\"overdraw_moves\":%llu}\n",
-      set.cluster_count, set.component_count, cpca::cluster_method_name(set.method),
-      cpca::pca_solver_name(set.solver), set.alpha, set.overdraw_reduction ? "true" : "false",
-      report.lbg_iterations, report.cpca_iterations, report.splits, report.lbg_seconds,
-      report.pca_seconds, report.cpca_seconds, report.overdraw_seconds, report.clustering_seconds(),
-      report.total_seconds, report.error.average_squared_error, report.error.relative_error,
-      report.error.max_squared_error, report.size.ratio, sizes.file_bytes,
-      (unsigned long long)s.one, (unsigned long long)s.two, (unsigned long long)s.three,
-      (unsigned long long)report.overdraw.moves);
+  const Json line = {{"clusters", set.cluster_count},
+                     {"pcs", set.component_count},
+                     {"method", cpca::cluster_method_name(set.method)},
+                     {"pca", cpca::pca_solver_name(set.solver)},
+                     {"alpha", set.alpha},
+                     {"overdraw_reduction", set.overdraw_reduction},
+                     {"lbg_iterations", report.lbg_iterations},
+                     {"cpca_iterations", report.cpca_iterations},
+                     {"splits", report.splits},
+                     {"lbg_seconds", report.lbg_seconds},
+                     {"pca_seconds", report.pca_seconds},
+                     {"cpca_seconds", report.cpca_seconds},
+                     {"overdraw_seconds", report.overdraw_seconds},
+                     {"clustering_seconds", report.clustering_seconds()},
+                     {"total_seconds", report.total_seconds},
+                     {"average_se", report.error.average_squared_error},
+                     {"relative_error", report.error.relative_error},
+                     {"max_se", report.error.max_squared_error},
+                     {"ratio", report.size.ratio},
+                     {"file_bytes", std::uint64_t(sizes.file_bytes)},
+                     {"triangles_1", std::uint64_t(s.one)},
+                     {"triangles_2", std::uint64_t(s.two)},
+                     {"triangles_3", std::uint64_t(s.three)},
+                     {"overdraw_moves", std::uint64_t(report.overdraw.moves)}};
+  std::printf("%s\n", dump_json(line).c_str());
 }
 
 void print_text(const Options& o, const cpca::CompressedSet& set,

@@ -1,7 +1,8 @@
 // prtr overdraw MESH --probe PROBE: the overdraw benchmark (apps/prtr/overdraw_run.h), which
 // reproduces the thesis's tables 5.2-5.17 (ch. 5) on our meshes. This file only turns flags
-// into a plan and writes the report: Markdown or JSON on stdout, CSV, JSON and the plot in
-// --out (the run itself writes the cluster and overdraw pictures there).
+// into a plan and writes the report: Markdown or JSON on stdout, CSV and JSON in --out (the
+// run itself writes the cluster and overdraw pictures there), then has
+// scripts/plot_overdraw.py draw the plot from the CSV when python3-matplotlib is installed.
 #include "bake_flags.h"
 #include "commands.h"
 #include "compress_flags.h"
@@ -9,6 +10,7 @@
 #include "overdraw_run.h"
 #include "pipeline.h"
 #include "progress_bar.h"
+#include "subprocess.h"
 
 #include "common/atomic_file.h"
 #include "cpca/supercluster_strategy.h"
@@ -147,22 +149,49 @@ OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
   return plan;
 }
 
+// Debian's own interpreter first: python3-matplotlib is installed for it, while a python3
+// earlier on PATH (a virtualenv, pyenv) often lacks matplotlib.
+std::string python_with_matplotlib() {
+  for (const char* python : {"/usr/bin/python3", "python3"})
+    if (run_program({python, "-c", "import matplotlib"}, true) == 0) return python;
+  return "";
+}
+
+// The plot step: scripts/plot_overdraw.py draws overdraw-plot.png from the CSV. Returns what
+// to tell the user: where the plot is, or why there is none and the command that makes it.
+std::string plot(const fs::path& csv_path, const std::string& budget) {
+  const std::string script = PRTR_PLOT_SCRIPT;
+  const fs::path png = csv_path.parent_path() / "overdraw-plot.png";
+  const std::string by_hand = script + " " + csv_path.string() + " --budget " + budget;
+  if (!fs::is_regular_file(script))
+    return "no plot: " + script + " is missing (prtr was moved from its source tree)";
+  const std::string python = python_with_matplotlib();
+  if (python.empty())
+    return "no plot: python3 with matplotlib is not installed (apt-get install "
+           "python3-matplotlib), then run: " +
+           by_hand;
+  if (run_program({python, script, csv_path.string(), "-o", png.string(), "--budget", budget},
+                  true) != 0)
+    return "no plot: " + script + " failed; run it by hand to see why: " + by_hand;
+  return "plot " + png.string();
+}
+
 void write_outputs(const OverdrawReport& report, const OverdrawPlan& plan, bool as_json) {
   const fs::path out = plan.pictures;
   const std::string csv_text = csv(report), json_text = json(report);
   common::write_file_atomically(out / "overdraw.csv", csv_text.data(), csv_text.size());
   common::write_file_atomically(out / "overdraw.json", json_text.data(), json_text.size());
-  render::write_picture_png(out / "overdraw-plot.png",
-                            overdraw_plot(report, plot_budget(plan.budgets)));
+  const std::string plotted = plot(out / "overdraw.csv", plot_budget(plan.budgets));
   if (as_json) {
     std::fputs(json_text.c_str(), stdout);
+    if (!plan.quiet) std::fprintf(stderr, "overdraw: %s\n", plotted.c_str());
     return;
   }
   std::fputs(markdown(report).c_str(), stdout);
   std::printf(
-      "\nWrote %s/overdraw.csv, overdraw.json, overdraw-plot.png and the K=%d cluster and "
-      "overdraw pictures.\n",
-      out.string().c_str(), *std::max_element(plan.clusters.begin(), plan.clusters.end()));
+      "\nWrote %s/overdraw.csv, overdraw.json and the K=%d cluster and overdraw pictures; %s\n",
+      out.string().c_str(), *std::max_element(plan.clusters.begin(), plan.clusters.end()),
+      plotted.c_str());
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 // prtr relight MESH --probe PROBE: the whole pipeline in one command. Bakes and compresses
 // through the cache (a second run with the same inputs skips both), then renders a frame
 // sequence while the environment turns about an axis (SH rotation per frame, no
-// re-projection), writing EXR frames, PNG previews, a contact sheet and, when ffmpeg is
-// installed, an MP4.
+// re-projection), writing EXR frames, PNG previews, a contact sheet, an animated GIF and,
+// when ffmpeg is installed, an MP4.
+#include "animation.h"
 #include "bake_flags.h"
 #include "commands.h"
 #include "compress_flags.h"
@@ -25,7 +26,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <numbers>
@@ -51,24 +51,6 @@ void remove_old_frames(const fs::path& dir) {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec))
     if (std::regex_match(entry.path().filename().string(), pattern)) fs::remove(entry.path(), ec);
-}
-
-bool have_ffmpeg() {
-  return std::system("command -v ffmpeg >/dev/null 2>&1") == 0;
-}
-
-// Encodes the PNG previews; the MP4 appears under its name only when ffmpeg succeeded.
-bool encode_video(const fs::path& dir, const fs::path& output, int fps) {
-  const fs::path temporary = dir / ".relight.tmp.mp4";
-  const std::string command = "ffmpeg -y -loglevel error -framerate " + std::to_string(fps) +
-                              " -i '" + (dir / "frame_%04d.png").string() +
-                              "' -vf 'scale=trunc(iw/2)*2:trunc(ih/2)*2' -pix_fmt yuv420p '" +
-                              temporary.string() + "'";
-  const bool ok = std::system(command.c_str()) == 0;
-  std::error_code ec;
-  if (ok) fs::rename(temporary, output, ec);
-  fs::remove(temporary, ec);
-  return ok && !ec;
 }
 
 double median(std::vector<double> v) {
@@ -124,7 +106,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--fps", o.fps, "Video frame rate")
       ->check(CLI::Range(1, 240))
       ->capture_default_str();
-  cmd->add_flag("--no-video", o.no_video, "Do not encode an MP4 even if ffmpeg is installed");
+  cmd->add_flag("--no-video", o.no_video, "Do not encode the MP4 (the GIF is always written)");
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
 }
 
@@ -215,11 +197,21 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
   return times;
 }
 
-std::string make_video(const Options& o) {
-  if (o.no_video) return "skipped (--no-video)";
-  if (!have_ffmpeg()) return "skipped (ffmpeg is not installed)";
+// Always the GIF; the MP4 too unless --no-video. What to print on the "animation" line.
+std::string make_animations(const Options& o) {
+  const fs::path gif = fs::path(o.out) / "relight.gif";
+  write_gif(o.out, o.frames, o.fps, gif);
+  if (o.no_video) return gif.string() + "; MP4 skipped (--no-video)";
   const fs::path mp4 = fs::path(o.out) / "relight.mp4";
-  return encode_video(o.out, mp4, o.fps) ? mp4.string() : "failed (ffmpeg reported an error)";
+  switch (write_mp4(o.out, o.fps, mp4)) {
+    case VideoResult::kWritten:
+      return gif.string() + ", " + mp4.string();
+    case VideoResult::kNoFfmpeg:
+      return gif.string() + "; no MP4: ffmpeg is not installed (apt-get install ffmpeg)";
+    case VideoResult::kFailed:
+      break;
+  }
+  return gif.string() + "; no MP4: ffmpeg reported an error";
 }
 
 void print_summary(const Options& o, const render::RenderStats& st, const render::Camera& camera,
@@ -232,7 +224,7 @@ void print_summary(const Options& o, const render::RenderStats& st, const render
       "GL %.2f ms), %.2f s with EXR/PNG output\n",
       o.frames, o.out.c_str(), median(t.frame_ms), 1000.0 / median(t.frame_ms), median(t.cpu_ms),
       median(t.gl_ms), t.seconds);
-  std::printf("video       %s\n", video.c_str());
+  std::printf("animation   %s\n", video.c_str());
   std::printf("total       %.1f s\n", total_s);
   std::printf("contact sheet: %s\n", sheet.string().c_str());
 }
@@ -244,7 +236,7 @@ Runner add_relight_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "relight",
       "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
-      "previews, a contact sheet and an MP4");
+      "previews, a contact sheet, an animated GIF and an MP4 (ffmpeg)");
   add_flags(cmd, *opt);
 
   return [opt] {
@@ -271,7 +263,7 @@ Runner add_relight_command(CLI::App& app) {
     const FrameTimes times = render_frames(o, *renderer, camera, lighting, thumbnails);
     const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
     render::write_png(sheet, tile(thumbnails, o.columns), o.view.exposure);
-    const std::string video = make_video(o);
+    const std::string video = make_animations(o);
     print_summary(o, renderer->stats(), camera, times, video, sheet, seconds_since(start));
   };
 }

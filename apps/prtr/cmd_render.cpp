@@ -3,6 +3,7 @@
 // frame times (render/renderer.h describes the modes).
 #include "commands.h"
 #include "flag_checks.h"
+#include "json_output.h"
 #include "pass_grouping.h"
 #include "view_flags.h"
 
@@ -29,10 +30,9 @@
 namespace prtr_app {
 namespace {
 
-std::string json_list(const std::vector<std::uint64_t>& values) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < values.size(); ++i) s += (i ? "," : "") + std::to_string(values[i]);
-  return s + "]";
+// "[a,b,c]": the per-pass triangle counts, as the text report and error messages show them.
+std::string count_list(const std::vector<std::uint64_t>& values) {
+  return dump_json(Json(values));
 }
 
 struct Options {
@@ -138,7 +138,7 @@ void print_report(const Options& o, const render::RenderStats& st,
         st.registers_per_cluster);
     std::printf("overdraw    %.4f (%llu triangles, drawn per pass %s)\n", st.average_overdraw,
                 static_cast<unsigned long long>(st.triangle_count),
-                json_list(st.triangles_per_pass).c_str());
+                count_list(st.triangles_per_pass).c_str());
     std::printf(
         "timing      %.2f FPS: frame %.2f ms median (cpu update %.2f ms, gl %.2f ms) over %d "
         "frames\n",
@@ -146,13 +146,17 @@ void print_report(const Options& o, const render::RenderStats& st,
         timing.frames);
   }
   if (o.json) {
-    std::printf(
-        "{\"mode\":\"%s\",\"width\":%d,\"height\":%d,\"passes\":%d,\"triangles_per_pass\":%s,"
-        "\"average_overdraw\":%.6f,\"fps\":%.3f,\"frame_ms_median\":%.3f,"
-        "\"cpu_update_ms\":%.3f,\"gl_ms\":%.3f}\n",
-        o.mode.c_str(), o.view.width, o.view.height, st.passes,
-        json_list(st.triangles_per_pass).c_str(), st.average_overdraw, timing.fps,
-        timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median);
+    const Json line = {{"mode", o.mode},
+                       {"width", o.view.width},
+                       {"height", o.view.height},
+                       {"passes", st.passes},
+                       {"triangles_per_pass", st.triangles_per_pass},
+                       {"average_overdraw", st.average_overdraw},
+                       {"fps", timing.fps},
+                       {"frame_ms_median", timing.frame_ms_median},
+                       {"cpu_update_ms", timing.cpu_ms_median},
+                       {"gl_ms", timing.gl_ms_median}};
+    std::printf("%s\n", dump_json(line).c_str());
   }
 }
 
@@ -197,9 +201,9 @@ Runner add_render_command(CLI::App& app) {
     if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
     const render::RenderStats& st = renderer->stats();
     if (!st.measured_triangles.empty() && st.measured_triangles != st.triangles_per_pass)
-      throw std::runtime_error("GL counted " + json_list(st.measured_triangles) +
+      throw std::runtime_error("GL counted " + count_list(st.measured_triangles) +
                                " triangles per pass but the grouping predicts " +
-                               json_list(st.triangles_per_pass) + " (a renderer bug)");
+                               count_list(st.triangles_per_pass) + " (a renderer bug)");
     print_report(o, st, timing);
   };
 }

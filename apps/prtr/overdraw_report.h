@@ -1,10 +1,8 @@
-// apps/prtr/overdraw_report.h: the results of `prtr overdraw` and their four
+// apps/prtr/overdraw_report.h: the results of `prtr overdraw` and their three
 // renderings: Markdown tables in the thesis's column order (tables 5.2-5.17: method,
-// clustering time, average triangle overdraw, FPS, Average SE, then our image RMSE), CSV,
-// JSON, and the plot of overdraw against cluster count.
+// clustering time, average triangle overdraw, FPS, Average SE, then our image RMSE), CSV and
+// JSON. The plot is drawn from the CSV by scripts/plot_overdraw.py.
 #pragma once
-
-#include "render/false_colour.h"
 
 #include <cstdint>
 #include <string>
@@ -58,12 +56,6 @@ struct OverdrawReport {
 std::string markdown(const OverdrawReport& report);
 std::string csv(const OverdrawReport& report);
 std::string json(const OverdrawReport& report);
-
-// Average overdraw against K, one line per method with its lowest-overdraw strategy at each
-// K, for the rows of `budget`; axes, ticks and a legend. Throws std::invalid_argument when
-// there is no row for `budget`.
-render::Picture overdraw_plot(const OverdrawReport& report, const std::string& budget,
-                              int width = 900, int height = 600);
 
 // "3 m 53 s" / "12.4 s", the thesis's style for clustering times.
 std::string format_duration(double seconds);

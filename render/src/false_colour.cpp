@@ -246,20 +246,6 @@ void fill_rect(Picture& picture, Rect rect, const Colour8& colour) {
       picture.set(x, y, colour);
 }
 
-void draw_line(Picture& picture, double x0, double y0, double x1, double y1, const Colour8& colour,
-               int thickness) {
-  const double length = std::hypot(x1 - x0, y1 - y0);
-  const int steps = std::max(1, int(std::ceil(length * 2)));
-  const int half = std::max(0, thickness - 1) / 2;
-  for (int s = 0; s <= steps; ++s) {
-    const double t = double(s) / steps;
-    const int cx = int(std::floor(x0 + t * (x1 - x0)));
-    const int cy = int(std::floor(y0 + t * (y1 - y0)));
-    fill_rect(picture, {cx - half, cy - half, cx - half + thickness, cy - half + thickness},
-              colour);
-  }
-}
-
 bool draw_text(Picture& picture, int x, int y, const std::string& text, int size,
                const Colour8& colour) {
   OIIO::ImageSpec spec(picture.width, picture.height, 3, OIIO::TypeDesc::UINT8);

@@ -2,7 +2,7 @@
 // picture
 // (each triangle coloured by how many passes draw it: 1, 2, 3+, with a legend drawn into the
 // image) and the cluster picture (one colour per cluster), plus the small 2D drawing kit the
-// legend and the benchmark's plot use.
+// legend uses.
 //
 // Conventions:
 //  - A Picture holds display colours: 8-bit sRGB-encoded RGB, row 0 at the top. Unlike
@@ -98,12 +98,9 @@ struct Rect {
 };
 Rect legend_swatch(int picture_height, int count);
 
-// --- Drawing kit (also used by the benchmark's plot) ------------------------------------------
+// --- Drawing kit (the legends) ------------------------------------------------------------
 
 void fill_rect(Picture& picture, Rect rect, const Colour8& colour);  // clipped to the picture
-// A line `thickness` pixels wide from (x0, y0) to (x1, y1), clipped.
-void draw_line(Picture& picture, double x0, double y0, double x1, double y1, const Colour8& colour,
-               int thickness = 1);
 // Text with its baseline starting at (x, y), `size` pixels high, in the first of the fonts
 // OpenImageIO finds (DejaVu Sans on Debian). Returns false, drawing nothing, when no font is
 // available: text is decoration, the pictures stay valid without it.
