@@ -222,6 +222,15 @@ TEST(HostilePly, BigEndianAndExtraPropertiesLoad) {
   EXPECT_NEAR(meshes::double_area(m, m.triangles[0]), 1.0, 1e-6);
 }
 
+// --- STL ------------------------------------------------------------------------------------
+
+TEST(HostileStl, TruncatedBinaryIsNamedAsSuch) {
+  std::string stl(80, '\0');
+  stl += bytes_of(std::uint32_t(5));
+  stl += std::string(100, '\0');
+  expect_mesh_error(write_file("short.stl", stl), "claims 5 triangles");
+}
+
 // --- Extreme but finite coordinates -----------------------------------------------------------
 
 TEST(HostileGeometry, TriangleNearTheFloatLimitIsNotDegenerate) {

@@ -35,6 +35,7 @@
 #include <mutex>
 #include <new>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 #include <unordered_map>
 #include <vector>
@@ -189,7 +190,9 @@ std::mutex& reader_mutex() {
 // Binary STL is exactly 84 + 50 n bytes for the n in its header. OpenMesh decides by whether
 // the file starts with "solid", which many binary exporters also write into their header, so
 // we decide here by size and tell the reader.
-bool is_binary_stl(const fs::path& path, std::uintmax_t size) {
+// A file that does not start with "solid" can only be binary; when its size disagrees with
+// its triangle count it is truncated (or padded), which `problem` then says.
+bool is_binary_stl(const fs::path& path, std::uintmax_t size, std::string& problem) {
   if (size < 84) return false;
   std::ifstream in(path, std::ios::binary);
   char header[84];
@@ -197,7 +200,13 @@ bool is_binary_stl(const fs::path& path, std::uintmax_t size) {
   const auto* b = reinterpret_cast<const unsigned char*>(header + 80);
   const std::uintmax_t n = std::uintmax_t{b[0]} | (std::uintmax_t{b[1]} << 8) |
                            (std::uintmax_t{b[2]} << 16) | (std::uintmax_t{b[3]} << 24);
-  return size == 84 + 50 * n;
+  if (size == 84 + 50 * n) return true;
+  if (std::string_view(header, 5) != "solid") {
+    problem = "binary STL whose header claims " + std::to_string(n) + " triangles (" +
+              std::to_string(84 + 50 * n) + " bytes), but the file has " + std::to_string(size) +
+              " bytes; it is truncated or damaged, re-export it";
+  }
+  return false;
 }
 
 // --- Welding -----------------------------------------------------------------------------------
@@ -441,7 +450,9 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
   }
   if (format == "stl") {
     // Through the stream interface, so the binary/ASCII decision is ours.
-    const bool binary = is_binary_stl(path, size);
+    std::string problem;
+    const bool binary = is_binary_stl(path, size, problem);
+    if (!problem.empty()) throw fail(problem);
     std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
     if (binary) opt += omio::Options::Binary;
     return omio::IOManager().read(in, ".stl", importer, opt);
