@@ -546,7 +546,8 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
   }
   if (importer.positions.empty() && importer.face_count() == 0) {
     throw fail("no vertices and no faces found; check that this is really a ." + format +
-               " mesh file (the " + upper(format) + " reader skips lines it does not know)");
+               " mesh file (the " + upper(format) + " reader skips " +
+               (format == "3ds" ? "chunks" : "lines") + " it does not know)");
   }
   if (importer.face_count() == 0) {
     throw fail("the file has no faces, only " + std::to_string(importer.positions.size()) +
