@@ -269,6 +269,20 @@ TEST(HostileProbe, ExrAttributeClaimingGigabytes) {
   std::string negative = std::string("\x76\x2f\x31\x01", 4) + bytes_of(std::uint32_t(2));
   negative += exr_attribute("owner", "string", -5, "abc");
   expect_probe_error(write_file("negative.exr", negative), "attribute 'owner'");
+  // A channel list whose declared size is short of its records: OpenEXR reads the records,
+  // not the size, so it reads the next attribute (here claiming 1.9 GB) from elsewhere than
+  // a walk by sizes would. Found by fuzz_probe_exr.
+  std::string channel = std::string("R\0", 2) + std::string(16, '\0');
+  std::string desync = std::string("\x76\x2f\x31\x01", 4) + bytes_of(std::uint32_t(2));
+  desync += exr_attribute("channels", "chlist", 1, channel + '\0');
+  desync += exr_attribute("x", "string", 1900000000, std::string(100, 'x'));
+  expect_probe_error(write_file("desync.exr", desync), "attribute 'channels' (chlist)");
+  // A preview image larger than the file.
+  std::string preview = std::string("\x76\x2f\x31\x01", 4) + bytes_of(std::uint32_t(2));
+  preview += exr_attribute(
+      "preview", "preview", 16,
+      bytes_of(std::uint32_t(30000)) + bytes_of(std::uint32_t(30000)) + std::string(8, '\0'));
+  expect_probe_error(write_file("preview.exr", preview), "attribute 'preview'");
 }
 
 // --- Stale temporaries ----------------------------------------------------------------------

@@ -23,6 +23,7 @@
 #include <numbers>
 #include <sstream>
 #include <system_error>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -53,9 +54,47 @@ std::string gigabytes(double bytes) {
   return buf;
 }
 
+// The number of bytes OpenEXR reads for an attribute value of `type` starting at `at`, which
+// for most types is fixed by the type and not by the size the file declares; -1 for types
+// whose value is as long as the declared size (strings, vectors, unknown types), -2 when a
+// value does not end within `limit`.
+std::int64_t exr_value_bytes(const std::string& type, const std::vector<char>& bytes,
+                             std::size_t at, std::size_t limit) {
+  static const std::unordered_map<std::string, std::int64_t> kFixed = {
+      {"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
+      {"compression", 1}, {"double", 8},   {"envmap", 1},
+      {"float", 4},       {"int", 4},      {"keycode", 28},
+      {"lineOrder", 1},   {"m33f", 36},    {"m33d", 72},
+      {"m44f", 64},       {"m44d", 128},   {"rational", 8},
+      {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
+      {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
+      {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
+  if (const auto it = kFixed.find(type); it != kFixed.end()) return it->second;
+  if (type == "chlist") {
+    // Channel records (name\0, then 16 bytes) up to an empty name.
+    std::size_t pos = at;
+    while (pos < limit && bytes[pos] != 0) {
+      while (pos < limit && bytes[pos] != 0) ++pos;
+      pos += 1 + 16;
+    }
+    return pos < limit ? std::int64_t(pos + 1 - at) : -2;
+  }
+  if (type == "preview") {
+    // Width and height, then 4 bytes per pixel: the size of the buffer OpenEXR allocates.
+    if (at + 8 > limit) return -2;
+    std::uint32_t wh[2];
+    std::memcpy(wh, bytes.data() + at, 8);
+    return std::int64_t(8 + 4 * std::uint64_t(wh[0]) * wh[1]);
+  }
+  return -1;
+}
+
 // Walks the attribute list of an OpenEXR header (name\0 type\0 int32 size, value) and
-// returns the first attribute whose size is negative or runs past the end of the file; empty
-// when every size fits. Multi-part files hold several headers, ended by an empty one.
+// returns the first attribute whose size is negative, runs past the end of the file, or
+// differs from what OpenEXR will read for its type (OpenEXR then reads the rest of the header
+// from a different place than the sizes say, so a check by sizes alone would be blind); empty
+// when every attribute is consistent. Multi-part files hold several headers, ended by an
+// empty one.
 std::string check_exr_header(const std::filesystem::path& path, std::uintmax_t file_size) {
   std::ifstream in(path, std::ios::binary);
   // Headers are small; what matters is that no attribute claims more than the file holds.
@@ -97,6 +136,14 @@ std::string check_exr_header(const std::filesystem::path& path, std::uintmax_t f
                " bytes in all; the file is damaged or truncated, re-export it";
       }
       if (std::size_t(size) > bytes.size() - at) return {};
+      const std::int64_t takes = exr_value_bytes(type, bytes, at, bytes.size());
+      if (takes != -1 && takes != size) {
+        return "its OpenEXR header attribute '" + name + "' (" + type + ") declares " +
+               std::to_string(size) + " bytes, but its value " +
+               (takes == -2 ? std::string("does not end within the file")
+                            : "takes " + std::to_string(takes)) +
+               "; the file is damaged, re-export it";
+      }
       at += std::size_t(size);
     }
     if (!multipart || !any) break;
