@@ -81,6 +81,9 @@ add huger.hdr probe "HDR claiming 2e9 x 1e9"
 add attribute.exr probe "1 KB EXR whose string attribute claims 1.9 GB"
 { printf '\x76\x2f\x31\x01'; le V 2; printf 'owner\0string\0'; le l -5; printf 'abc'; } >negative.exr
 add negative.exr probe "EXR attribute with a negative size"
+{ printf '\x76\x2f\x31\x01'; le V 2; printf 'channels\0chlist\0'; le V 1; printf 'R\0'; head -c 17 /dev/zero
+  printf 'x\0string\0'; le V 1900000000; head -c 100 /dev/zero | tr '\0' x; } >desync.exr
+add desync.exr probe "EXR channel list declaring 1 byte for 19, then an attribute claiming 1.9 GB"
 echo "not an image" >garbage.exr
 add garbage.exr probe "text that is not an image"
 if [[ -f $probe ]]; then
