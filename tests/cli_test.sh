@@ -211,6 +211,33 @@ if [[ -f $forest ]]; then
   run "${rl[@]}"; expect_code 0 && [[ $out == *"bake        cached"* && $out == *"compress    cached"* ]]; check "relight: second run uses the cache" $?
   for entry in "$tmp"/rl_cache/cpca-*.prtc; do head -c 200 "$entry" >"$entry.cut" && mv "$entry.cut" "$entry"; done
   run "${rl[@]}"; expect_code 0 && [[ $err == *unusable* && $out == *"compress    compressed"* ]]; check "relight: a damaged cache entry is reported and rebuilt" $?
+  # Payload damage (one flipped byte past the header) is found by the full read, reported,
+  # removed and rebuilt, in every combination of entries; the run succeeds, and the next one
+  # finds a sound cache.
+  flip() {  # flip FILE OFFSET: invert one byte in place
+    local b; b=$(od -An -tu1 -j "$2" -N1 "$1" | tr -d ' ')
+    printf "\\$(printf %03o $((b ^ 255)))" | dd of="$1" bs=1 seek="$2" conv=notrunc status=none
+  }
+  for entry in "$tmp"/rl_cache/cpca-*.prtc; do flip "$entry" $(($(stat -c %s "$entry") - 3)); done
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*payload* && $out == *"bake        cached"* && $out == *"compress    compressed"* ]]; check "relight: a damaged .prtc payload is rebuilt ($err)" $?
+  run "${rl[@]}"; expect_code 0 && [[ $out == *"compress    cached"* && $err != *unusable* ]]; check "relight: the rebuilt .prtc is used" $?
+  for entry in "$tmp"/rl_cache/bake-*.prtx; do flip "$entry" 200; done
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*payload* && $out == *"bake        baked"* ]]; check "relight: a damaged .prtx payload is rebuilt although its .prtc exists ($err)" $?
+  for entry in "$tmp"/rl_cache/bake-*.prtx; do flip "$entry" 200; done
+  rm -f "$tmp"/rl_cache/cpca-*
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*payload* && $out == *"bake        baked"* && $out == *"compress    compressed"* ]]; check "relight: a damaged .prtx payload without its .prtc is rebuilt ($err)" $?
+  run "${rl[@]}"; expect_code 0 && [[ $out == *"bake        cached"* && $out == *"compress    cached"* && $err != *unusable* ]]; check "relight: the repaired cache is used without complaint" $?
+
+  # Temporaries of a killed run: those of a process that is gone are swept at the start, from
+  # the cache and from the folder an output is written to; a live writer's are left alone.
+  bash -c 'exit 0' & gone=$!; wait $gone
+  printf 'partial' >"$tmp/rl_cache/.bake-0123.prtx.tmp-$gone-77"
+  printf 'partial' >"$tmp/rl_cache/.cpca-0123.prtc.tmp-$$-78"
+  run "${rl[@]}"; expect_code 0 && [[ ! -e $tmp/rl_cache/.bake-0123.prtx.tmp-$gone-77 && -e $tmp/rl_cache/.cpca-0123.prtc.tmp-$$-78 && $err == *"interrupted run"* ]]; check "relight: stale cache temporaries swept, live ones kept" $?
+  rm -f "$tmp/rl_cache/.cpca-0123.prtc.tmp-$$-78"
+  mkdir -p "$tmp/outdir" && printf 'partial' >"$tmp/outdir/.old.prtx.tmp-$gone-5"
+  run bake "$tmp/cube.obj" -o "$tmp/outdir/cube.prtx" --order 2 --samples 16 --bounces 0 --quiet
+  expect_code 0 && [[ ! -e $tmp/outdir/.old.prtx.tmp-$gone-5 && -s $tmp/outdir/cube.prtx ]]; check "bake: stale temporaries in the output folder swept" $?
   run relight "$tmp/missing.obj" --probe "$forest" --out "$tmp/rl2"; expect_code 1 && [[ $err == *missing.obj* ]]; check "relight: missing mesh exits 1 naming it" $?
   run relight "$tmp/cube.obj" --probe "$tmp/garbage.exr" --clusters 2 --out "$tmp/rl2"; expect_code 1 && [[ $err == *garbage.exr* ]]; check "relight: unreadable probe exits 1 naming it" $?
   ! ls "$tmp"/rl2/frame_* >/dev/null 2>&1; check "relight: failures leave no frames" $?

@@ -54,28 +54,12 @@ constexpr std::size_t kHeaderBytes = 128;
 fs::path scratch(const std::string& name) {
   return test_support::scratch("compressed_file", name);
 }
+using test_support::patch;
+using test_support::peek;
 using test_support::slurp;
 
-template <class T>
-T peek(const std::string& bytes, std::size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof(T));
-  return v;
-}
-
-template <class T>
-void patch(const fs::path& p, std::size_t offset, T value) {
-  std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
-  ASSERT_TRUE(f) << p;
-  f.seekp(std::streamoff(offset));
-  f.write(reinterpret_cast<const char*>(&value), sizeof(T));
-  ASSERT_TRUE(f) << p;
-}
-
-// Recomputes the header checksum, so that a patched field is caught by its own check.
 void reseal_header(const fs::path& p) {
-  const std::string bytes = slurp(p);
-  patch<std::uint64_t>(p, kOffHeaderChecksum, common::fnv1a(bytes.data(), kOffHeaderChecksum));
+  test_support::reseal_header(p, kOffHeaderChecksum);
 }
 
 std::size_t payload_offset(const CompressedSet& set) {
@@ -124,7 +108,7 @@ CompressedSet make_set(int order, int channels, bool glossy, std::uint64_t verti
 
 template <class T>
 bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+  return a.size() == b.size() && test_support::same_bytes(a.data(), b.data(), a.size() * sizeof(T));
 }
 
 void expect_same_header(const CompressedSet& a, const CompressedSet& b) {

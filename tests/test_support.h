@@ -1,11 +1,17 @@
-// tests/test_support.h: helpers shared by the test suites (scratch files, quadrature).
+// tests/test_support.h: helpers shared by the test suites (scratch files, byte patching of
+// binary files, quadrature).
 #pragma once
 
+#include "common/hash.h"
+
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,6 +29,39 @@ inline std::string slurp(const std::filesystem::path& p) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+// The value of type T stored at `offset` in a file's bytes (read by memcpy: unaligned).
+template <class T>
+T peek(const std::string& bytes, std::size_t offset) {
+  if (offset + sizeof(T) > bytes.size()) throw std::out_of_range("peek past the end");
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof(T));
+  return v;
+}
+
+// Overwrites sizeof(T) bytes at `offset` in place, as a damaged or forged file would have.
+// Throws rather than asserting so that it works in helpers that return values.
+template <class T>
+void patch(const std::filesystem::path& p, std::size_t offset, T value) {
+  std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
+  if (!f) throw std::runtime_error("cannot open " + p.string() + " to patch it");
+  f.seekp(std::streamoff(offset));
+  f.write(reinterpret_cast<const char*>(&value), sizeof(T));
+  if (!f) throw std::runtime_error("cannot patch " + p.string());
+}
+
+// Recomputes a header checksum (FNV-1a of the bytes before it, stored at `checksum_offset`),
+// so that a patched field is caught by its own check rather than by the checksum.
+inline void reseal_header(const std::filesystem::path& p, std::size_t checksum_offset) {
+  const std::string bytes = slurp(p);
+  patch<std::uint64_t>(p, checksum_offset, common::fnv1a(bytes.data(), checksum_offset));
+}
+
+// Bitwise equality of two arrays. memcmp must not see the null data() of an empty vector
+// (undefined behaviour even for a zero length), so empty arrays are compared by size alone.
+inline bool same_bytes(const void* a, const void* b, std::size_t bytes) {
+  return bytes == 0 || std::memcmp(a, b, bytes) == 0;
 }
 
 // Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n); exact for polynomials of

@@ -53,30 +53,12 @@ constexpr std::size_t kPayloadOffset = 128;
 fs::path scratch(const std::string& name) {
   return test_support::scratch("transfer_file", name);
 }
+using test_support::patch;
+using test_support::peek;
 using test_support::slurp;
 
-template <class T>
-T peek(const std::string& bytes, std::size_t offset) {
-  T v;
-  std::memcpy(&v, bytes.data() + offset, sizeof(T));
-  return v;
-}
-
-// Overwrites sizeof(T) bytes at `offset` in place, as a damaged or forged file would have.
-template <class T>
-void patch(const fs::path& p, std::size_t offset, T value) {
-  std::fstream f(p, std::ios::in | std::ios::out | std::ios::binary);
-  ASSERT_TRUE(f) << p;
-  f.seekp(std::streamoff(offset));
-  f.write(reinterpret_cast<const char*>(&value), sizeof(T));
-  ASSERT_TRUE(f) << p;
-}
-
-// Recomputes the header checksum, so that a patched field is caught by its own check rather
-// than by the checksum.
 void reseal_header(const fs::path& p) {
-  const std::string bytes = slurp(p);
-  patch<std::uint64_t>(p, kOffHeaderChecksum, common::fnv1a(bytes.data(), kOffHeaderChecksum));
+  test_support::reseal_header(p, kOffHeaderChecksum);
 }
 
 TransferSet make_set(TransferKind kind, int order, int channels, std::uint64_t vertices,
@@ -121,7 +103,8 @@ void expect_same(const TransferSet& a, const TransferSet& b) {
   EXPECT_EQ(a.material.f0, b.material.f0);
   ASSERT_EQ(a.data.size(), b.data.size());
   // Bitwise, so that -0 and denormals count too.
-  EXPECT_EQ(std::memcmp(a.data.data(), b.data.data(), a.data.size() * sizeof(float)), 0);
+  EXPECT_TRUE(
+      test_support::same_bytes(a.data.data(), b.data.data(), a.data.size() * sizeof(float)));
 }
 
 // Runs `read` and returns the TransferFileError's message, failing if it names neither the

@@ -111,8 +111,16 @@ void prepare(const fs::path& dir) {
                              ec.message() + "); pass --cache DIR or set PRTR_CACHE");
 }
 
+// A bake or compression killed mid-write leaves its temporary (up to the size of a whole
+// bake) in the cache; nothing else would ever remove it.
+void sweep(const fs::path& dir) {
+  for (const fs::path& file : common::sweep_stale_temporaries(dir)) {
+    std::fprintf(stderr, "prtr: removed %s, left by an interrupted run\n", file.string().c_str());
+  }
+}
+
 void discard(const fs::path& entry, const std::exception& why) {
-  std::fprintf(stderr, "prtr: cache entry %s is unusable (%s); rebuilding it\n",
+  std::fprintf(stderr, "prtr: cache entry %s is unusable (%s); removing and rebuilding it\n",
                entry.string().c_str(), why.what());
   std::error_code ec;
   fs::remove(entry, ec);
@@ -125,16 +133,21 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
   std::ostringstream key;
   key.precision(9);
   const prt::Material& m = o.material;
-  key << "bake v1 mesh " << hex(meshes::content_hash(mesh)) << " kind " << int(o.kind) << " order "
+  // The version names the baker's algorithm: bump it whenever the same inputs bake to other
+  // numbers (v2: rays start on the face they leave through), so old entries are not reused.
+  key << "bake v2 mesh " << hex(meshes::content_hash(mesh)) << " kind " << int(o.kind) << " order "
       << o.order << " samples " << o.samples << " bounces " << o.bounces << " seed " << o.seed
       << " ray_offset " << o.ray_offset << " material " << int(m.kind) << ' ' << m.albedo.x() << ' '
       << m.albedo.y() << ' ' << m.albedo.z() << ' ' << m.specular << ' ' << m.exponent << ' '
       << m.roughness << ' ' << m.f0;
   CacheResult r{cache_dir / ("bake-" + hex(hash_text(key.str())) + ".prtx"), false};
+  sweep(cache_dir);
   if (fs::exists(r.path)) {
     try {
-      const prt::TransferSet header = prt::read_transfer_header(r.path);
-      if (header.mesh_hash != meshes::content_hash(mesh))
+      // The whole file, payload checksum included: a header check alone let a damaged payload
+      // through to every later run.
+      const prt::TransferSet entry = prt::read_transfer(r.path);
+      if (entry.mesh_hash != meshes::content_hash(mesh))
         throw std::runtime_error("baked from another mesh");
       r.hit = true;
       return r;
@@ -150,6 +163,7 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
 CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes::Mesh& mesh,
                                     const std::string& mesh_path, const cpca::CompressOptions& o,
                                     const fs::path& cache_dir, bool quiet, bool rebuild) {
+  sweep(cache_dir);
   const prt::TransferSet header = prt::read_transfer_header(transfer_path);
   std::ostringstream key;
   key.precision(9);
@@ -167,7 +181,8 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
   const fs::path summary = cache_dir / (stem + ".summary");
   if (!rebuild && fs::exists(r.path)) {
     try {
-      const cpca::CompressedSet set = cpca::read_compressed_header(r.path);
+      // The whole file, for the same reason as the bake's.
+      const cpca::CompressedSet set = cpca::read_compressed(r.path);
       if (set.transfer_hash != header.payload_checksum)
         throw std::runtime_error("compressed from another bake");
       std::ifstream in(summary);

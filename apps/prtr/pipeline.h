@@ -7,8 +7,10 @@
 //   bake-<hash>.prtx   mesh content hash + every bake option
 //   cpca-<hash>.prtc   transfer payload checksum + every compression option
 //   cpca-<hash>.summary  that compression's clustering time and errors
-// Entries are written atomically, so an interrupted run leaves no entry (never half of one);
-// an entry that fails validation is reported, deleted and rebuilt.
+// Entries are written atomically, so an interrupted run leaves no entry (never half of one),
+// and the temporaries of runs killed mid-write are swept on the next lookup. An entry is read
+// in full, payload checksum included, before it is trusted; one that fails is reported,
+// deleted and rebuilt, so a damaged cache costs a rebuild, never a failed run.
 #pragma once
 
 #include "cpca/compress.h"

@@ -1,11 +1,15 @@
 #include "common/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
+#include <chrono>
 #include <cstring>
 #include <random>
+#include <string_view>
 
 namespace common {
 namespace {
@@ -14,7 +18,54 @@ std::string errno_text() {
   return std::strerror(errno);
 }
 
+constexpr std::string_view kTempMarker = ".tmp-";
+constexpr auto kAlwaysStaleAfter = std::chrono::hours(24);
+
+// The pid in ".<name>.tmp-<pid>-<n>", or 0 when `file` is not named like our temporaries.
+pid_t temporary_owner(const std::string& file) {
+  if (file.size() < 2 || file[0] != '.') return 0;
+  const std::size_t marker = file.rfind(kTempMarker);
+  if (marker == std::string::npos || marker < 2) return 0;
+  const std::string_view rest = std::string_view(file).substr(marker + kTempMarker.size());
+  const std::size_t dash = rest.find('-');
+  if (dash == std::string_view::npos || dash == 0 || dash + 1 == rest.size()) return 0;
+  long pid = 0;
+  const auto [end, ec] = std::from_chars(rest.data(), rest.data() + dash, pid);
+  if (ec != std::errc() || end != rest.data() + dash || pid <= 0) return 0;
+  unsigned long suffix = 0;
+  const auto [end2, ec2] =
+      std::from_chars(rest.data() + dash + 1, rest.data() + rest.size(), suffix);
+  if (ec2 != std::errc() || end2 != rest.data() + rest.size()) return 0;
+  return static_cast<pid_t>(pid);
+}
+
+bool process_gone(pid_t pid) {
+  return ::kill(pid, 0) != 0 && errno == ESRCH;
+}
+
 }  // namespace
+
+std::vector<std::filesystem::path> sweep_stale_temporaries(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> removed;
+  std::error_code ec;
+  fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec);
+  if (ec) return removed;
+  const auto now = fs::file_time_type::clock::now();
+  for (; it != fs::directory_iterator(); it.increment(ec)) {
+    if (ec) break;
+    const pid_t owner = temporary_owner(it->path().filename().string());
+    if (owner == 0 || owner == ::getpid()) continue;
+    std::error_code file_ec;
+    if (!it->is_regular_file(file_ec)) continue;
+    const auto written = it->last_write_time(file_ec);
+    const bool old = !file_ec && now - written > kAlwaysStaleAfter;
+    if ((old || process_gone(owner)) && fs::remove(it->path(), file_ec)) {
+      removed.push_back(it->path());
+    }
+  }
+  return removed;
+}
 
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   const std::filesystem::path dir =
@@ -24,13 +75,16 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
     throw IoError(target_.string() + ": directory " + dir.string() +
                   " does not exist; create it first or choose another output path");
   }
+  // Earlier runs killed mid-write leave their temporaries here; this is the first moment we
+  // know the directory is in use again.
+  sweep_stale_temporaries(dir);
   // A unique name in the same directory, so the final rename stays on one file system.
   std::random_device rd;
   for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
     // Built with append: GCC 12 reports a false -Wrestrict on chained operator+ here.
     std::string name = ".";
     name.append(target_.filename().string())
-        .append(".tmp-")
+        .append(kTempMarker)
         .append(std::to_string(::getpid()))
         .append("-")
         .append(std::to_string(rd() & 0xffffff));

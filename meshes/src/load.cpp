@@ -1,5 +1,10 @@
-// meshes/load.cpp: OBJ/PLY/OFF/STL through OpenMesh's IO layer, 3DS through our own reader,
-// then clean-up (weld, drop degenerate and unreferenced, frames).
+// meshes/load.cpp: OBJ and STL through OpenMesh's IO layer, OFF, PLY and 3DS through our own
+// readers, then clean-up (weld, drop degenerate and unreferenced, frames).
+//
+// OpenMesh's OFF and PLY readers size buffers from unchecked header counts and read values
+// they never set after a parse error (see read_strict.h), which no guard in front of them can
+// fix; they are replaced. Its OBJ reader is kept behind a strict pre-pass over face lines,
+// and its STL reader behind our own binary/ASCII decision by file size.
 //
 // OpenMesh is used only for parsing. Its readers feed a BaseImporter; OpenMesh's own
 // ImporterT builds a halfedge mesh, which cannot hold non-manifold ("complex") faces: it
@@ -16,6 +21,7 @@
 #include "meshes/load.h"
 
 #include "read_3ds.h"
+#include "read_strict.h"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
@@ -25,8 +31,11 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <mutex>
+#include <new>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 #include <unordered_map>
 #include <vector>
@@ -62,6 +71,13 @@ std::string describe(const Vec3& v) {
   std::ostringstream out;
   out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
   return out.str();
+}
+
+// In double: for coordinates near the float limit (a triangle at +-3e38) the float
+// difference max - min overflows to infinity, and an infinite diagonal makes every
+// triangle's area look negligible.
+double diagonal_of(const Bounds& box) {
+  return (box.max.cast<double>() - box.min.cast<double>()).norm();
 }
 
 // --- Reading ---------------------------------------------------------------------------------
@@ -174,7 +190,9 @@ std::mutex& reader_mutex() {
 // Binary STL is exactly 84 + 50 n bytes for the n in its header. OpenMesh decides by whether
 // the file starts with "solid", which many binary exporters also write into their header, so
 // we decide here by size and tell the reader.
-bool is_binary_stl(const fs::path& path, std::uintmax_t size) {
+// A file that does not start with "solid" can only be binary; when its size disagrees with
+// its triangle count it is truncated (or padded), which `problem` then says.
+bool is_binary_stl(const fs::path& path, std::uintmax_t size, std::string& problem) {
   if (size < 84) return false;
   std::ifstream in(path, std::ios::binary);
   char header[84];
@@ -182,7 +200,13 @@ bool is_binary_stl(const fs::path& path, std::uintmax_t size) {
   const auto* b = reinterpret_cast<const unsigned char*>(header + 80);
   const std::uintmax_t n = std::uintmax_t{b[0]} | (std::uintmax_t{b[1]} << 8) |
                            (std::uintmax_t{b[2]} << 16) | (std::uintmax_t{b[3]} << 24);
-  return size == 84 + 50 * n;
+  if (size == 84 + 50 * n) return true;
+  if (std::string_view(header, 5) != "solid") {
+    problem = "binary STL whose header claims " + std::to_string(n) + " triangles (" +
+              std::to_string(84 + 50 * n) + " bytes), but the file has " + std::to_string(size) +
+              " bytes; it is truncated or damaged, re-export it";
+  }
+  return false;
 }
 
 // --- Welding -----------------------------------------------------------------------------------
@@ -215,7 +239,7 @@ std::vector<std::uint32_t> weld_map(const std::vector<Vec3>& positions, double t
   for (std::size_t v = 0; v < n; ++v) remap[v] = static_cast<std::uint32_t>(v);
   if (tolerance < 0.0 || n == 0) return remap;
 
-  const double diagonal = box.diagonal();
+  const double diagonal = diagonal_of(box);
   const double eps = tolerance * diagonal;
   if (!(tolerance >= kSmallestGridTolerance) || !(eps > 0.0)) {
     // Exact matches only (+0 and -0 are the same point).
@@ -283,7 +307,7 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
   CleanCounts counts;
   const std::size_t triangles_in = mesh.triangles.size();
   const Bounds box = bounds(mesh);
-  const double diagonal = box.diagonal();
+  const double diagonal = diagonal_of(box);
 
   const std::vector<std::uint32_t> remap = weld_map(mesh.positions, options.weld_tolerance, box);
   for (std::size_t v = 0; v < remap.size(); ++v) {
@@ -359,6 +383,88 @@ std::string upper(std::string s) {
   return s;
 }
 
+std::string read_all(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Moves what one of our readers produced into the importer, which range-checks the indices.
+void deliver(detail::RawPolygons& raw, CollectingImporter& importer) {
+  importer.positions = std::move(raw.positions);
+  importer.face_offsets = std::move(raw.face_offsets);
+  importer.corners.reserve(raw.corners.size());
+  for (const std::int64_t index : raw.corners) {
+    if (index < 0 || std::uint64_t(index) >= importer.positions.size()) {
+      if (!importer.has_bad_face) {
+        importer.has_bad_face = true;
+        const auto at = std::size_t(&index - raw.corners.data());
+        importer.bad_face = std::size_t(
+            std::upper_bound(importer.face_offsets.begin(), importer.face_offsets.end(), at) -
+            importer.face_offsets.begin() - 1);
+        importer.bad_index = index;
+      }
+      importer.corners.push_back(0);
+    } else {
+      importer.corners.push_back(std::uint32_t(index));
+    }
+  }
+}
+
+// Fills `importer` from the file; returns false when OpenMesh's reader gave up, throws what
+// `fail` makes for problems our own readers name.
+template <class Fail>
+bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
+           CollectingImporter& importer, const Fail& fail) {
+  const std::lock_guard<std::mutex> lock(reader_mutex());
+  omio::Options opt;
+  if (format == "3ds") {
+    detail::Raw3ds raw;
+    const std::string problem = detail::read_3ds(path, raw);
+    if (!problem.empty()) throw fail(problem);
+    for (const Vec3& p : raw.positions) importer.positions.push_back(p);
+    for (std::size_t c = 0; c < raw.corners.size(); c += 3) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::uint32_t index = raw.corners[c + k];
+        if (index >= importer.positions.size() && !importer.has_bad_face) {
+          importer.has_bad_face = true;
+          importer.bad_face = importer.face_count();
+          importer.bad_index = index;
+        }
+        importer.corners.push_back(index < importer.positions.size() ? index : 0);
+      }
+      importer.face_offsets.push_back(importer.corners.size());
+    }
+    return true;
+  }
+  if (format == "off" || format == "ply") {
+    const std::string bytes = read_all(path);
+    detail::RawPolygons raw;
+    const std::string problem =
+        format == "off" ? detail::read_off(bytes, raw) : detail::read_ply(bytes, raw);
+    if (!problem.empty()) {
+      throw fail("could not parse this file as " + upper(format) + ": " + problem +
+                 "; fix or re-export the file");
+    }
+    deliver(raw, importer);
+    return true;
+  }
+  if (format == "stl") {
+    // Through the stream interface, so the binary/ASCII decision is ours.
+    std::string problem;
+    const bool binary = is_binary_stl(path, size, problem);
+    if (!problem.empty()) throw fail(problem);
+    std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
+    if (binary) opt += omio::Options::Binary;
+    return omio::IOManager().read(in, ".stl", importer, opt);
+  }
+  // OBJ: OpenMesh asserts on face corners without a vertex number, so they never reach it.
+  if (const std::string problem = detail::check_obj_faces(read_all(path)); !problem.empty()) {
+    throw fail("could not parse this file as OBJ: " + problem + "; fix the line");
+  }
+  // OpenMesh picks the reader by the extension (case-insensitively).
+  return omio::IOManager().read(path.string(), importer, opt);
+}
+
 }  // namespace
 
 void clean_mesh(Mesh& mesh, const LoadOptions& options, LoadReport* report) {
@@ -412,44 +518,22 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
     throw fail("cannot be opened for reading; check its permissions");
   }
 
-  // Parse.
+  // Parse. Memory use is bounded by the file's size (every reader checks counts against the
+  // bytes that are left), so running out of memory here means the file itself is too large.
   CollectingImporter importer;
   bool parsed = false;
-  {
-    const std::lock_guard<std::mutex> lock(reader_mutex());
-    omio::Options opt;
-    if (format == "3ds") {
-      detail::Raw3ds raw;
-      const std::string problem = detail::read_3ds(path, raw);
-      if (!problem.empty()) throw fail(problem);
-      for (const Vec3& p : raw.positions) importer.positions.push_back(p);
-      for (std::size_t c = 0; c < raw.corners.size(); c += 3) {
-        for (std::size_t k = 0; k < 3; ++k) {
-          const std::uint32_t index = raw.corners[c + k];
-          if (index >= importer.positions.size() && !importer.has_bad_face) {
-            importer.has_bad_face = true;
-            importer.bad_face = importer.face_count();
-            importer.bad_index = index;
-          }
-          importer.corners.push_back(index < importer.positions.size() ? index : 0);
-        }
-        importer.face_offsets.push_back(importer.corners.size());
-      }
-      parsed = true;
-    } else if (format == "stl") {
-      // Through the stream interface, so the binary/ASCII decision is ours.
-      const bool binary = is_binary_stl(path, size);
-      std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
-      if (binary) opt += omio::Options::Binary;
-      parsed = omio::IOManager().read(in, ".stl", importer, opt);
-    } else {
-      // OpenMesh picks the reader by the extension (case-insensitively).
-      parsed = omio::IOManager().read(path.string(), importer, opt);
-    }
+  try {
+    parsed = parse(path, format, size, importer, fail);
+  } catch (const std::bad_alloc&) {
+    throw fail("too large to load into memory (" + std::to_string(size) +
+               " bytes); free memory or simplify the mesh");
+  } catch (const std::length_error&) {
+    throw fail("too large to load into memory (" + std::to_string(size) +
+               " bytes); free memory or simplify the mesh");
   }
   if (!parsed) {
-    throw fail("OpenMesh could not parse this file as " + upper(format) +
-               "; check that it is a valid ." + format + " file (re-export it if unsure)");
+    throw fail("could not parse this file as " + upper(format) + "; check that it is a valid ." +
+               format + " file (re-export it if unsure)");
   }
   if (importer.has_bad_face) {
     std::ostringstream msg;
@@ -462,7 +546,8 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
   }
   if (importer.positions.empty() && importer.face_count() == 0) {
     throw fail("no vertices and no faces found; check that this is really a ." + format +
-               " mesh file (the " + upper(format) + " reader skips lines it does not know)");
+               " mesh file (the " + upper(format) + " reader skips " +
+               (format == "3ds" ? "chunks" : "lines") + " it does not know)");
   }
   if (importer.face_count() == 0) {
     throw fail("the file has no faces, only " + std::to_string(importer.positions.size()) +

@@ -3,6 +3,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <vector>
 
 namespace meshes::detail {
 namespace {
@@ -22,27 +23,40 @@ struct Parser {
   Raw3ds& out;
   std::string problem;
 
-  // Walks the chunks in [begin, end); `base` is the index of this object's first vertex.
-  bool walk(std::size_t begin, std::size_t end, std::size_t& base) {
-    std::size_t at = begin;
-    while (at + 6 <= end) {
+  // Walks the chunk tree under [begin, end). Containers nest as deep as the file says, so the
+  // walk keeps its own stack of open containers on the heap instead of recursing: depth costs
+  // 16 bytes per level and is bounded by the file size (a chunk takes at least 6 bytes).
+  bool walk(std::size_t begin, std::size_t end) {
+    struct Open {
+      std::size_t at, end;
+    };
+    std::vector<Open> open{{begin, end}};
+    std::size_t base = 0;  // index of the current object's first vertex
+    while (!open.empty()) {
+      Open& top = open.back();
+      if (top.at + 6 > top.end) {
+        open.pop_back();
+        continue;
+      }
+      const std::size_t at = top.at;
       std::uint16_t id = 0;
       std::uint32_t length = 0;
       read_at(bytes, at, id);
       read_at(bytes, at + 2, length);
-      if (length < 6 || at + length > end) {
+      if (length < 6 || length > top.end - at) {
         problem = "chunk 0x" + hex(id) + " at byte " + std::to_string(at) + " claims " +
                   std::to_string(length) + " bytes, past its parent's end; the file is damaged";
         return false;
       }
       const std::size_t body = at + 6, stop = at + length;
+      top.at = stop;  // before the push below, which may move `top`
       if (id == kMain || id == kEditor || id == kTriMesh) {
         if (id == kTriMesh) base = out.positions.size();
-        if (!walk(body, stop, base)) return false;
+        open.push_back({body, stop});
       } else if (id == kObject) {
         std::size_t name_end = body;
         while (name_end < stop && bytes[name_end] != 0) ++name_end;  // object name
-        if (!walk(name_end + 1, stop, base)) return false;
+        open.push_back({name_end + 1, stop});
       } else if (id == kVertices) {
         std::uint16_t n = 0;
         if (!read_at(bytes, body, n) || body + 2 + std::size_t(n) * 12 > stop)
@@ -62,7 +76,6 @@ struct Parser {
           for (int c = 0; c < 3; ++c) out.corners.push_back(std::uint32_t(base + f[c]));
         }
       }
-      at = stop;
     }
     return true;
   }
@@ -90,8 +103,7 @@ std::string read_3ds(const std::filesystem::path& path, Raw3ds& out) {
   if (!read_at(bytes, 0, id) || id != kMain)
     return "not a 3DS file (it does not start with the main chunk 0x4d4d)";
   Parser parser{bytes, out, {}};
-  std::size_t base = 0;
-  if (!parser.walk(0, bytes.size(), base)) return parser.problem;
+  if (!parser.walk(0, bytes.size())) return parser.problem;
   return {};
 }
 

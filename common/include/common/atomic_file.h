@@ -1,7 +1,8 @@
 // common/atomic_file.h: write a file so that readers see either the old file or the whole
 // new one, never a part. Data goes to a temporary file in the same directory, is flushed to
 // disk, and is renamed over the target on commit(). If commit() is never reached (an
-// exception, an early return), the destructor removes the temporary file.
+// exception, an early return), the destructor removes the temporary file; if the process is
+// killed first, the next AtomicFile in that directory sweeps it (sweep_stale_temporaries).
 #pragma once
 
 #include <cstddef>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace common {
 
@@ -40,6 +42,14 @@ class AtomicFile {
   int fd_ = -1;
   bool committed_ = false;
 };
+
+// Removes the temporaries AtomicFile left in `dir` when its process died before commit() or
+// its destructor ran (kill -9, a crash, power loss): files named .<name>.tmp-<pid>-<n> whose
+// process no longer runs, or older than a day whatever their pid says (pids are reused, and
+// a file from another machine or container names a pid that means nothing here). A writer
+// that is still running is never disturbed. Returns the files removed; problems are ignored,
+// since a missed sweep only costs disk space.
+std::vector<std::filesystem::path> sweep_stale_temporaries(const std::filesystem::path& dir);
 
 // Convenience: the whole file from one buffer.
 void write_file_atomically(const std::filesystem::path& target, const void* data,

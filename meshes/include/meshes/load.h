@@ -1,4 +1,5 @@
-// meshes/load.h: reading meshes from disk through OpenMesh (OBJ, PLY, OFF, STL).
+// meshes/load.h: reading meshes from disk: OBJ and STL through OpenMesh, OFF, PLY and 3DS
+// through our own strict readers.
 //
 // Loading triangulates polygons (fan), drops degenerate faces (repeated index or zero area
 // after welding), welds positions closer than `weld_tolerance` times the bounding-box
@@ -25,10 +26,10 @@ struct LoadOptions {
 struct LoadReport {
   std::string path;
   std::string format;  // lower-case extension: "obj", "ply", "off", "stl"
-  // As OpenMesh's reader delivered them, which is not always every record in the file: its
-  // OBJ reader skips faces that repeat a vertex index or have fewer than three corners, and
-  // its STL reader merges bit-identical corners and skips triangles that repeat one. Such
-  // faces are in neither file_faces nor degenerate_faces_dropped.
+  // As the reader delivered them. Ours (OFF, PLY, 3DS) deliver every record; OpenMesh's are
+  // not always complete: its OBJ reader skips faces that repeat a vertex index or have fewer
+  // than three corners, and its STL reader merges bit-identical corners and skips triangles
+  // that repeat one. Such faces are in neither file_faces nor degenerate_faces_dropped.
   std::size_t file_vertices = 0;
   std::size_t file_faces = 0;
   std::size_t polygons_triangulated = 0;  // faces with more than three corners
@@ -42,10 +43,13 @@ struct LoadReport {
 };
 
 // Throws MeshError whose message starts with the path and says what to do, for: a missing or
-// unreadable file, a directory, an unknown extension, an empty file, content OpenMesh cannot
-// parse, a face naming a vertex that does not exist, NaN/Inf coordinates, or no faces (in
-// the file, or left after clean-up). The binary/ASCII decision for .stl is made by file size
-// (84 + 50 n bytes is binary), not by OpenMesh's "starts with solid" test.
+// unreadable file, a directory, an unknown extension, an empty file, content the reader
+// cannot parse (including header counts the file is too small to hold, and OBJ face corners
+// without a vertex number), a face naming a vertex that does not exist, NaN/Inf coordinates,
+// a file too large for memory, or no faces (in the file, or left after clean-up). Memory use
+// is bounded by a constant times the file size, whatever the file claims. The binary/ASCII decision
+// for .stl is made by file size (84 + 50 n bytes is binary), not by OpenMesh's "starts with solid"
+// test.
 Mesh load_mesh(const std::filesystem::path& path, const LoadOptions& options = {},
                LoadReport* report = nullptr);
 

@@ -1,0 +1,71 @@
+// fuzz/fuzz_support.h: what every libFuzzer target here shares. The loaders under test take
+// paths, so each input is written to a file first; the file lives in memory (/dev/shm) where
+// there is one, so that the write costs microseconds.
+#pragma once
+
+#include "common/hash.h"
+
+#include <unistd.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fuzz_support {
+
+// A path ending in `extension` that belongs to this process alone (libFuzzer's -fork and
+// -jobs modes run several processes side by side).
+inline const std::filesystem::path& scratch_path(const std::string& extension) {
+  static const std::filesystem::path path = [&] {
+    const std::filesystem::path base = std::filesystem::is_directory("/dev/shm")
+                                           ? "/dev/shm"
+                                           : std::filesystem::temp_directory_path();
+    const std::filesystem::path dir = base / ("prtr-fuzz-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    return dir / ("input" + extension);
+  }();
+  return path;
+}
+
+inline const std::filesystem::path& write_input(const std::uint8_t* data, std::size_t size,
+                                                const std::string& extension) {
+  const std::filesystem::path& path = scratch_path(extension);
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  return path;
+}
+
+inline void put_u64(std::uint8_t* at, std::uint64_t v) {
+  std::memcpy(at, &v, sizeof v);
+}
+
+// The layouts below mirror prt/src/transfer_file.cpp and cpca/src/compressed_file.cpp: a
+// 128-byte header whose last 8 bytes are the FNV-1a of the 120 before them.
+constexpr std::size_t kHeaderBytes = 128;
+constexpr std::size_t kHeaderChecksum = 120;
+
+// .prtx: payload checksum at 104 over everything after the header.
+inline void reseal_transfer(std::uint8_t* data, std::size_t size) {
+  if (size < kHeaderBytes) return;
+  put_u64(data + 104, common::fnv1a(data + kHeaderBytes, size - kHeaderBytes));
+  put_u64(data + kHeaderChecksum, common::fnv1a(data, kHeaderChecksum));
+}
+
+// .prtc: mesh path (length at 52, padded to 8 bytes) after the header, checksum at 112; the
+// payload after it, checksum at 104.
+inline void reseal_compressed(std::uint8_t* data, std::size_t size) {
+  if (size < kHeaderBytes) return;
+  std::uint32_t path_bytes = 0;
+  std::memcpy(&path_bytes, data + 52, 4);
+  const std::size_t block = (std::size_t(path_bytes) + 7) / 8 * 8;
+  if (block <= size - kHeaderBytes) {
+    put_u64(data + 112, common::fnv1a(data + kHeaderBytes, path_bytes));
+    put_u64(data + 104, common::fnv1a(data + kHeaderBytes + block, size - kHeaderBytes - block));
+  }
+  put_u64(data + kHeaderChecksum, common::fnv1a(data, kHeaderChecksum));
+}
+
+}  // namespace fuzz_support

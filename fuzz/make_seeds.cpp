@@ -1,0 +1,225 @@
+// fuzz/make_seeds: writes the seed corpus of the mesh and probe fuzz targets from the real
+// inputs, small: a patch of the Stanford bunny and glmark2's cube and low-poly asteroid in
+// every mesh format we read, and downsampled Blender studio lights as HDR and EXR. (The
+// .prtx and .prtc seeds are written by prtr itself; see scripts/fuzz.sh.)
+// Seeds must be small (libFuzzer mutates whole files; -max_len caps them) and valid, so that
+// mutations start inside each format rather than at its first check.
+//
+// Usage: make_seeds OUTPUT_DIR BUNNY_OBJ MODELS_DIR PROBES_DIR
+#include "meshes/load.h"
+#include "probes/load.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace fs = std::filesystem;
+using meshes::Mesh;
+
+namespace {
+
+void write(const fs::path& p, const std::string& bytes) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << bytes;
+}
+
+template <class T>
+void put(std::string& out, T v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+// The triangles of `mesh` that use only its first `limit` vertices.
+Mesh patch(const Mesh& mesh, std::uint32_t limit) {
+  Mesh out;
+  std::unordered_map<std::uint32_t, std::uint32_t> index;
+  for (const meshes::Triangle& t : mesh.triangles) {
+    if (t[0] >= limit || t[1] >= limit || t[2] >= limit) continue;
+    meshes::Triangle n;
+    for (int k = 0; k < 3; ++k) {
+      auto [it, fresh] = index.try_emplace(t[k], std::uint32_t(out.positions.size()));
+      if (fresh) out.positions.push_back(mesh.positions[t[k]]);
+      n[k] = it->second;
+    }
+    out.triangles.push_back(n);
+  }
+  return out;
+}
+
+std::string obj(const Mesh& m) {
+  std::ostringstream s;
+  s << "# seed\n";
+  for (const auto& p : m.positions) s << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (std::size_t i = 0; i < m.triangles.size(); ++i) {
+    const auto& t = m.triangles[i];
+    // Every corner spelling, so that mutations start from each.
+    if (i % 3 == 0) s << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    if (i % 3 == 1) s << "f " << t[0] + 1 << "//1 " << t[1] + 1 << "//1 " << t[2] + 1 << "//1\n";
+    if (i % 3 == 2) s << "f " << t[0] + 1 << "/1/1 " << t[1] + 1 << "/1 -1\n";
+  }
+  return s.str();
+}
+
+std::string off(const Mesh& m) {
+  std::ostringstream s;
+  s << "OFF\n" << m.positions.size() << ' ' << m.triangles.size() << " 0\n";
+  for (const auto& p : m.positions) s << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (const auto& t : m.triangles) s << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  return s.str();
+}
+
+std::string ply(const Mesh& m, bool binary) {
+  std::ostringstream h;
+  h << "ply\nformat " << (binary ? "binary_little_endian" : "ascii")
+    << " 1.0\ncomment seed\nelement vertex " << m.positions.size()
+    << "\nproperty float x\nproperty float y\nproperty float z\nelement face " << m.triangles.size()
+    << "\nproperty list uchar int vertex_indices\nend_header\n";
+  std::string s = h.str();
+  if (binary) {
+    for (const auto& p : m.positions) {
+      for (int k = 0; k < 3; ++k) put(s, p[k]);
+    }
+    for (const auto& t : m.triangles) {
+      put(s, std::uint8_t(3));
+      for (int k = 0; k < 3; ++k) put(s, std::int32_t(t[k]));
+    }
+    return s;
+  }
+  std::ostringstream b;
+  for (const auto& p : m.positions) b << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (const auto& t : m.triangles) b << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  return s + b.str();
+}
+
+std::string stl(const Mesh& m, bool binary) {
+  if (binary) {
+    std::string s(80, ' ');
+    put(s, std::uint32_t(m.triangles.size()));
+    for (const auto& t : m.triangles) {
+      for (int k = 0; k < 3; ++k) put(s, 0.f);
+      for (int c = 0; c < 3; ++c) {
+        for (int k = 0; k < 3; ++k) put(s, m.positions[t[c]][k]);
+      }
+      put(s, std::uint16_t(0));
+    }
+    return s;
+  }
+  std::ostringstream s;
+  s << "solid seed\n";
+  for (const auto& t : m.triangles) {
+    s << "facet normal 0 0 0\nouter loop\n";
+    for (int c = 0; c < 3; ++c) {
+      const auto& p = m.positions[t[c]];
+      s << "vertex " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+    }
+    s << "endloop\nendfacet\n";
+  }
+  s << "endsolid seed\n";
+  return s.str();
+}
+
+std::string chunk(std::uint16_t id, const std::string& body) {
+  std::string s;
+  put(s, id);
+  put(s, std::uint32_t(6 + body.size()));
+  return s + body;
+}
+
+std::string three_ds(const Mesh& m) {
+  std::string v, f;
+  put(v, std::uint16_t(m.positions.size()));
+  for (const auto& p : m.positions) {
+    put(v, p.x());
+    put(v, -p.z());  // back to 3DS's Z-up
+    put(v, p.y());
+  }
+  put(f, std::uint16_t(m.triangles.size()));
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) put(f, std::uint16_t(t[k]));
+    put(f, std::uint16_t(0));
+  }
+  const std::string object =
+      chunk(0x4000, std::string("seed\0", 5) + chunk(0x4100, chunk(0x4110, v) + chunk(0x4120, f)));
+  return chunk(0x4D4D, chunk(0x3D3D, object));
+}
+
+void mesh_seeds(const fs::path& out, const std::string& name, const Mesh& m) {
+  write(out / "mesh_obj" / (name + ".obj"), obj(m));
+  write(out / "mesh_off" / (name + ".off"), off(m));
+  write(out / "mesh_ply" / (name + "_ascii.ply"), ply(m, false));
+  write(out / "mesh_ply" / (name + "_binary.ply"), ply(m, true));
+  write(out / "mesh_stl" / (name + "_ascii.stl"), stl(m, false));
+  write(out / "mesh_stl" / (name + "_binary.stl"), stl(m, true));
+  if (m.positions.size() < 65536 && m.triangles.size() < 65536) {
+    write(out / "mesh_3ds" / (name + ".3ds"), three_ds(m));
+  }
+}
+
+// Nearest-texel downsample of a probe to width x width/2, written by OpenImageIO.
+void probe_seeds(const fs::path& out, const fs::path& source, int width) {
+  const probes::Probe p = probes::load_probe(source);
+  const int height = width / 2;
+  std::vector<float> pixels(std::size_t(width) * height * 3);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const auto& t = p.texels()[std::size_t(y * p.height() / height) * p.width() +
+                                 std::size_t(x * p.width() / width)];
+      for (int c = 0; c < 3; ++c) pixels[(std::size_t(y) * width + x) * 3 + c] = t[c];
+    }
+  }
+  const std::string stem = source.stem().string() + "_" + std::to_string(width);
+  struct Variant {
+    std::string dir, file, compression;
+    OIIO::TypeDesc type;
+  };
+  for (const Variant& v : {Variant{"probe_hdr", stem + ".hdr", "", OIIO::TypeDesc::FLOAT},
+                           Variant{"probe_exr", stem + "_zip.exr", "zip", OIIO::TypeDesc::HALF},
+                           Variant{"probe_exr", stem + "_raw.exr", "none", OIIO::TypeDesc::FLOAT},
+                           Variant{"probe_exr", stem + "_piz.exr", "piz", OIIO::TypeDesc::HALF}}) {
+    const fs::path path = out / v.dir / v.file;
+    fs::create_directories(path.parent_path());
+    auto file = OIIO::ImageOutput::create(path.string());
+    OIIO::ImageSpec spec(width, height, 3, v.type);
+    if (!v.compression.empty()) spec.attribute("compression", v.compression);
+    if (!file || !file->open(path.string(), spec) ||
+        !file->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !file->close()) {
+      throw std::runtime_error("cannot write " + path.string());
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 5) {
+    std::fprintf(stderr, "usage: make_seeds OUTPUT_DIR BUNNY_OBJ MODELS_DIR PROBES_DIR\n");
+    return 2;
+  }
+  try {
+    const fs::path out = argv[1], bunny = argv[2], models = argv[3], probe_dir = argv[4];
+    mesh_seeds(out, "bunny_patch", patch(meshes::load_mesh(bunny), 400));
+    for (const char* name : {"cube", "asteroid-low"}) {
+      const fs::path p = models / (std::string(name) + ".3ds");
+      fs::create_directories(out / "mesh_3ds");
+      fs::copy_file(p, out / "mesh_3ds" / p.filename(), fs::copy_options::overwrite_existing);
+      mesh_seeds(out, name, meshes::load_mesh(p));
+    }
+    for (const char* name : {"studio", "night", "city"}) {
+      probe_seeds(out, probe_dir / (std::string(name) + ".exr"), 32);
+    }
+    probe_seeds(out, probe_dir / "studio.exr", 8);
+
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "make_seeds: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

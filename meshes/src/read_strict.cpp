@@ -1,0 +1,526 @@
+#include "read_strict.h"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <optional>
+
+namespace meshes::detail {
+namespace {
+
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> split(std::string_view s) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    while (i < s.size() && is_space(s[i])) ++i;
+    const std::size_t begin = i;
+    while (i < s.size() && !is_space(s[i])) ++i;
+    if (i > begin) out.push_back(s.substr(begin, i - begin));
+  }
+  return out;
+}
+
+// Whole-token parses: trailing characters make the token invalid.
+template <class T>
+std::optional<T> parse_int(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  T v{};
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+std::optional<double> parse_real(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  double v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  // Out-of-range values are kept as the infinity they overflow to; the loader reports
+  // non-finite coordinates with the vertex index.
+  if (ec == std::errc::result_out_of_range && end == s.data() + s.size()) {
+    return s.front() == '-' ? -std::numeric_limits<double>::infinity()
+                            : std::numeric_limits<double>::infinity();
+  }
+  if (ec != std::errc() || end != s.data() + s.size() || s.empty()) return std::nullopt;
+  return v;
+}
+
+std::string quote(std::string_view token) {
+  constexpr std::size_t kShown = 24;
+  std::string out = "'";
+  for (char c : token.substr(0, kShown)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", u);
+      out += buf;
+    }
+  }
+  if (token.size() > kShown) out += "...";
+  return out + "'";
+}
+
+// Splits text into lines without copying; the last line may lack its newline.
+class Lines {
+ public:
+  explicit Lines(std::string_view text) : text_(text) {}
+  bool next(std::string_view& line) {
+    if (at_ >= text_.size()) return false;
+    const std::size_t end = text_.find('\n', at_);
+    const std::size_t stop = end == std::string_view::npos ? text_.size() : end;
+    line = text_.substr(at_, stop - at_);
+    at_ = end == std::string_view::npos ? text_.size() : end + 1;
+    ++number_;
+    return true;
+  }
+  std::size_t number() const { return number_; }  // 1-based number of the last line
+  std::size_t remaining() const { return text_.size() - at_; }
+
+ private:
+  std::string_view text_;
+  std::size_t at_ = 0;
+  std::size_t number_ = 0;
+};
+
+constexpr std::uint64_t kMaxIndexable = std::numeric_limits<std::uint32_t>::max();
+
+}  // namespace
+
+// --- OFF ------------------------------------------------------------------------------------
+
+std::string read_off(std::string_view bytes, RawPolygons& out) {
+  Lines lines(bytes);
+  std::string_view line;
+  // The next line with content, comments ('#' to the end of the line) removed.
+  const auto next_record = [&](std::vector<std::string_view>& tokens) {
+    while (lines.next(line)) {
+      const std::size_t hash = line.find('#');
+      tokens = split(hash == std::string_view::npos ? line : line.substr(0, hash));
+      if (!tokens.empty()) return true;
+    }
+    return false;
+  };
+  const auto at_line = [&] { return "line " + std::to_string(lines.number()) + ": "; };
+
+  std::vector<std::string_view> tokens;
+  if (!next_record(tokens)) return "no OFF header (the file holds only blank lines or comments)";
+  // [ST][C][N][4][n]OFF: the prefixes add per-vertex values after x y z, which are skipped.
+  const std::string_view keyword = tokens.front();
+  if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") {
+    return "the first line is " + quote(keyword) + ", not an OFF header";
+  }
+  const std::string_view prefix = keyword.substr(0, keyword.size() - 3);
+  if (prefix.find_first_not_of("STCN") != std::string_view::npos) {
+    return "header " + quote(keyword) +
+           ": only 3D OFF is read (4OFF and nOFF are not); convert the file to PLY or 3D OFF";
+  }
+  tokens.erase(tokens.begin());
+  if (!tokens.empty() && tokens.front() == "BINARY") {
+    return "binary OFF is not read; convert the file to ASCII OFF or to PLY";
+  }
+  // The counts may share the header's line.
+  if (tokens.empty() && !next_record(tokens)) return "the file ends before the element counts";
+  if (tokens.size() < 2) return at_line() + "expected 'vertices faces [edges]' counts";
+  const auto nv = parse_int<std::uint64_t>(tokens[0]);
+  const auto nf = parse_int<std::uint64_t>(tokens[1]);
+  if (!nv || !nf) {
+    return at_line() + "the counts " + quote(tokens[0]) + " " + quote(tokens[1]) +
+           " are not non-negative integers";
+  }
+  // The shortest vertex line is "0 0 0\n" (6 bytes), the shortest face "0\n" (2 bytes): a
+  // header claiming more than the rest of the file can hold is damaged, and is refused before
+  // anything is sized from it.
+  const std::uint64_t left = lines.remaining();
+  if (*nv > kMaxIndexable || *nf > kMaxIndexable || *nv > left / 6 || *nf > (left - 6 * *nv) / 2) {
+    return "the header claims " + std::to_string(*nv) + " vertices and " + std::to_string(*nf) +
+           " faces, but only " + std::to_string(left) +
+           " bytes follow it (at least 6 per vertex and 2 per face are needed); the header is "
+           "wrong or the file is truncated";
+  }
+  out.positions.reserve(*nv);
+  out.face_offsets.reserve(*nf + 1);
+
+  for (std::uint64_t v = 0; v < *nv; ++v) {
+    if (!next_record(tokens)) {
+      return "the file ends after " + std::to_string(v) + " of the " + std::to_string(*nv) +
+             " vertices its header claims; the file is truncated or the header is wrong";
+    }
+    if (tokens.size() < 3) return at_line() + "vertex " + std::to_string(v) + " has no x y z";
+    double p[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto x = parse_real(tokens[std::size_t(k)]);
+      if (!x) {
+        return at_line() + "vertex " + std::to_string(v) + ": " + quote(tokens[std::size_t(k)]) +
+               " is not a number";
+      }
+      p[k] = *x;
+    }
+    out.positions.emplace_back(float(p[0]), float(p[1]), float(p[2]));
+  }
+  for (std::uint64_t f = 0; f < *nf; ++f) {
+    if (!next_record(tokens)) {
+      return "the file ends after " + std::to_string(f) + " of the " + std::to_string(*nf) +
+             " faces its header claims; the file is truncated or the header is wrong";
+    }
+    const auto k = parse_int<std::uint64_t>(tokens[0]);
+    if (!k) {
+      return at_line() + "face " + std::to_string(f) + ": the corner count " + quote(tokens[0]) +
+             " is not a non-negative integer";
+    }
+    // Anything after the corners (a colour) is allowed and skipped.
+    if (*k > tokens.size() - 1) {
+      return at_line() + "face " + std::to_string(f) + " claims " + std::to_string(*k) +
+             " corners but its line lists " + std::to_string(tokens.size() - 1) + " values";
+    }
+    for (std::size_t c = 1; c <= *k; ++c) {
+      const auto index = parse_int<std::int64_t>(tokens[c]);
+      if (!index) {
+        return at_line() + "face " + std::to_string(f) + ": " + quote(tokens[c]) +
+               " is not a vertex index";
+      }
+      out.corners.push_back(*index);
+    }
+    out.face_offsets.push_back(out.corners.size());
+  }
+  return {};
+}
+
+// --- PLY ------------------------------------------------------------------------------------
+
+namespace {
+
+enum class Scalar { kInt8, kUint8, kInt16, kUint16, kInt32, kUint32, kFloat32, kFloat64 };
+
+std::optional<Scalar> scalar_of(std::string_view name) {
+  if (name == "char" || name == "int8") return Scalar::kInt8;
+  if (name == "uchar" || name == "uint8") return Scalar::kUint8;
+  if (name == "short" || name == "int16") return Scalar::kInt16;
+  if (name == "ushort" || name == "uint16") return Scalar::kUint16;
+  if (name == "int" || name == "int32") return Scalar::kInt32;
+  if (name == "uint" || name == "uint32") return Scalar::kUint32;
+  if (name == "float" || name == "float32") return Scalar::kFloat32;
+  if (name == "double" || name == "float64") return Scalar::kFloat64;
+  return std::nullopt;
+}
+
+std::size_t size_of(Scalar s) {
+  switch (s) {
+    case Scalar::kInt8:
+    case Scalar::kUint8:
+      return 1;
+    case Scalar::kInt16:
+    case Scalar::kUint16:
+      return 2;
+    case Scalar::kInt32:
+    case Scalar::kUint32:
+    case Scalar::kFloat32:
+      return 4;
+    case Scalar::kFloat64:
+      return 8;
+  }
+  return 8;
+}
+
+bool is_integer(Scalar s) {
+  return s != Scalar::kFloat32 && s != Scalar::kFloat64;
+}
+
+struct Property {
+  std::string name;
+  Scalar type = Scalar::kFloat32;
+  bool list = false;
+  Scalar count_type = Scalar::kUint8;
+};
+
+struct Element {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<Property> properties;
+};
+
+enum class Format { kAscii, kLittle, kBig };
+
+// Reads the values of the body one at a time, in either encoding. A value is a double: every
+// PLY scalar type converts to it exactly.
+class Values {
+ public:
+  Values(std::string_view body, Format format) : body_(body), format_(format) {}
+
+  // Empty on success, else the problem.
+  std::string next(Scalar type, double& value) {
+    if (format_ == Format::kAscii) return next_text(type, value);
+    const std::size_t n = size_of(type);
+    if (n > body_.size() - at_) return "the file ends in the middle of the data";
+    unsigned char b[8];
+    std::memcpy(b, body_.data() + at_, n);
+    at_ += n;
+    if ((format_ == Format::kBig) != (std::endian::native == std::endian::big)) {
+      std::reverse(b, b + n);
+    }
+    switch (type) {
+      case Scalar::kInt8:
+        value = double(std::bit_cast<std::int8_t>(b[0]));
+        break;
+      case Scalar::kUint8:
+        value = double(b[0]);
+        break;
+      case Scalar::kInt16:
+        value = double(load<std::int16_t>(b));
+        break;
+      case Scalar::kUint16:
+        value = double(load<std::uint16_t>(b));
+        break;
+      case Scalar::kInt32:
+        value = double(load<std::int32_t>(b));
+        break;
+      case Scalar::kUint32:
+        value = double(load<std::uint32_t>(b));
+        break;
+      case Scalar::kFloat32:
+        value = double(load<float>(b));
+        break;
+      case Scalar::kFloat64:
+        value = load<double>(b);
+        break;
+    }
+    return {};
+  }
+
+  std::size_t remaining() const { return body_.size() - at_; }
+
+ private:
+  template <class T>
+  static T load(const unsigned char* b) {
+    T v;
+    std::memcpy(&v, b, sizeof v);
+    return v;
+  }
+
+  std::string next_text(Scalar type, double& value) {
+    while (at_ < body_.size() && is_space(body_[at_])) ++at_;
+    if (at_ == body_.size()) return "the file ends in the middle of the data";
+    const std::size_t begin = at_;
+    while (at_ < body_.size() && !is_space(body_[at_])) ++at_;
+    const std::string_view token = body_.substr(begin, at_ - begin);
+    if (is_integer(type)) {
+      const auto v = parse_int<std::int64_t>(token);
+      if (!v) return quote(token) + " is not an integer";
+      value = double(*v);
+    } else {
+      const auto v = parse_real(token);
+      if (!v) return quote(token) + " is not a number";
+      value = *v;
+    }
+    return {};
+  }
+
+  std::string_view body_;
+  Format format_;
+  std::size_t at_ = 0;
+};
+
+}  // namespace
+
+std::string read_ply(std::string_view bytes, RawPolygons& out) {
+  Lines lines(bytes);
+  std::string_view line;
+  if (!lines.next(line) || trim(line) != "ply") return "it does not start with the line 'ply'";
+  std::optional<Format> format;
+  std::vector<Element> elements;
+  bool ended = false;
+  while (!ended && lines.next(line)) {
+    const auto at_line = [&] { return "header line " + std::to_string(lines.number()) + ": "; };
+    const std::vector<std::string_view> t = split(line);
+    if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "end_header") {
+      ended = true;
+    } else if (t[0] == "format") {
+      if (t.size() < 2) return at_line() + "'format' names no encoding";
+      if (t[1] == "ascii") {
+        format = Format::kAscii;
+      } else if (t[1] == "binary_little_endian") {
+        format = Format::kLittle;
+      } else if (t[1] == "binary_big_endian") {
+        format = Format::kBig;
+      } else {
+        return at_line() + "unknown encoding " + quote(t[1]);
+      }
+    } else if (t[0] == "element") {
+      if (t.size() != 3) return at_line() + "expected 'element <name> <count>'";
+      const auto count = parse_int<std::uint64_t>(t[2]);
+      if (!count) return at_line() + "the count " + quote(t[2]) + " is not a non-negative integer";
+      elements.push_back({std::string(t[1]), *count, {}});
+    } else if (t[0] == "property") {
+      if (elements.empty()) return at_line() + "a property before any element";
+      Property p;
+      if (t.size() == 5 && t[1] == "list") {
+        const auto count_type = scalar_of(t[2]);
+        const auto item_type = scalar_of(t[3]);
+        if (!count_type || !item_type || !is_integer(*count_type)) {
+          return at_line() + "unknown list types " + quote(t[2]) + " " + quote(t[3]);
+        }
+        p = {std::string(t[4]), *item_type, true, *count_type};
+      } else if (t.size() == 3) {
+        const auto type = scalar_of(t[1]);
+        if (!type) return at_line() + "unknown type " + quote(t[1]);
+        p = {std::string(t[2]), *type, false, Scalar::kUint8};
+      } else {
+        return at_line() + "expected 'property <type> <name>' or 'property list ...'";
+      }
+      elements.back().properties.push_back(p);
+    } else {
+      return at_line() + "unknown keyword " + quote(t[0]);
+    }
+  }
+  if (!ended) return "the header has no 'end_header' line";
+  if (!format) return "the header has no 'format' line";
+
+  // Every record takes at least one byte per scalar (binary) or two characters per value
+  // (text): counts the rest of the file cannot hold are refused before any allocation, and a
+  // record can never take zero bytes, so time is bounded by the file size too.
+  const std::uint64_t left = lines.remaining();
+  std::uint64_t needed = 0;
+  for (const Element& e : elements) {
+    if (e.count > 0 && e.properties.empty()) {
+      return "element '" + e.name + "' has no properties, so its " + std::to_string(e.count) +
+             " records cannot be read; the header is wrong";
+    }
+    std::uint64_t record = 0;
+    for (const Property& p : e.properties) {
+      record += *format == Format::kAscii ? 2 : size_of(p.list ? p.count_type : p.type);
+    }
+    if (e.count > kMaxIndexable || (record > 0 && e.count > (left - needed) / record)) {
+      return "the header claims " + std::to_string(e.count) + " '" + e.name +
+             "' records, but only " + std::to_string(left) +
+             " bytes of data follow it; the header is wrong or the file is truncated";
+    }
+    needed += e.count * record;
+  }
+
+  Values values(bytes.substr(bytes.size() - left), *format);
+  bool saw_vertices = false;
+  for (const Element& e : elements) {
+    const bool is_vertex = e.name == "vertex" && !saw_vertices;
+    const bool is_face = e.name == "face";
+    int xyz[3] = {-1, -1, -1};
+    int indices = -1;
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const Property& p = e.properties[i];
+      if (is_vertex && !p.list) {
+        if (p.name == "x") xyz[0] = int(i);
+        if (p.name == "y") xyz[1] = int(i);
+        if (p.name == "z") xyz[2] = int(i);
+      }
+      if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+        indices = int(i);
+      }
+    }
+    if (is_vertex) {
+      if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) {
+        return "element 'vertex' lacks one of the scalar properties x, y, z";
+      }
+      saw_vertices = true;
+      out.positions.reserve(e.count);
+    }
+    if (is_face) out.face_offsets.reserve(out.face_offsets.size() + e.count);
+
+    for (std::uint64_t r = 0; r < e.count; ++r) {
+      const auto where = [&] { return "'" + e.name + "' record " + std::to_string(r) + ": "; };
+      float p[3] = {0, 0, 0};
+      for (std::size_t i = 0; i < e.properties.size(); ++i) {
+        const Property& prop = e.properties[i];
+        double value = 0;
+        if (!prop.list) {
+          if (std::string problem = values.next(prop.type, value); !problem.empty()) {
+            return where() + problem;
+          }
+          for (int k = 0; k < 3; ++k) {
+            if (is_vertex && xyz[k] == int(i)) p[k] = float(value);
+          }
+          continue;
+        }
+        if (std::string problem = values.next(prop.count_type, value); !problem.empty()) {
+          return where() + problem;
+        }
+        // Checked against what is left before the items are read, so a forged count costs
+        // neither memory nor time.
+        const std::uint64_t per_item = *format == Format::kAscii ? 2 : size_of(prop.type);
+        if (value < 0 || value > double(values.remaining() / per_item + 1)) {
+          return where() + "list '" + prop.name + "' claims " + std::to_string(value) +
+                 " items, more than the rest of the file holds";
+        }
+        const auto n = std::uint64_t(value);
+        const bool keep = is_face && indices == int(i);
+        for (std::uint64_t k = 0; k < n; ++k) {
+          if (std::string problem = values.next(prop.type, value); !problem.empty()) {
+            return where() + problem;
+          }
+          if (keep) {
+            if (!(std::abs(value) < 9.2e18) || value != std::floor(value)) {
+              return where() + "vertex index " + std::to_string(value) + " is not an integer";
+            }
+            out.corners.push_back(std::int64_t(value));
+          }
+        }
+      }
+      if (is_vertex) out.positions.emplace_back(p[0], p[1], p[2]);
+      if (is_face && indices >= 0) out.face_offsets.push_back(out.corners.size());
+    }
+  }
+  if (!saw_vertices) return "the header declares no 'vertex' element";
+  return {};
+}
+
+// --- OBJ pre-pass -----------------------------------------------------------------------------
+
+std::string check_obj_faces(std::string_view bytes) {
+  Lines lines(bytes);
+  std::string_view line;
+  while (lines.next(line)) {
+    const std::vector<std::string_view> t = split(line);
+    if (t.empty() || t[0] != "f") continue;
+    const std::string where = "line " + std::to_string(lines.number()) + ": ";
+    if (t.size() == 1) return where + "a face ('f') with no corners";
+    for (std::size_t c = 1; c < t.size(); ++c) {
+      // v, v/vt, v//vn, v/vt/vn: the vertex index is required, the others may be empty.
+      std::string_view rest = t[c];
+      int parts = 0;
+      bool ok = true;
+      while (ok) {
+        const std::size_t slash = rest.find('/');
+        const std::string_view part = rest.substr(0, slash);
+        const auto v = parse_int<int>(part);
+        if (parts == 0) {
+          ok = v.has_value() && *v != 0;
+        } else {
+          ok = part.empty() || v.has_value();
+        }
+        ++parts;
+        if (slash == std::string_view::npos) break;
+        rest.remove_prefix(slash + 1);
+      }
+      if (!ok || parts > 3) {
+        return where + "face corner " + quote(t[c]) +
+               " is not v, v/vt, v//vn or v/vt/vn with v a non-zero vertex number";
+      }
+    }
+  }
+  return {};
+}
+
+}  // namespace meshes::detail

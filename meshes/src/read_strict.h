@@ -1,0 +1,38 @@
+// meshes/src/read_strict.h (private): our own readers for OFF and PLY, and a strict pre-pass
+// over OBJ face lines.
+//
+// OpenMesh's OFF and PLY readers trust their headers: they size buffers from header counts
+// and keep reading after a parse failure with values they never set, so a 30-byte file can
+// ask for gigabytes and the result depends on stack garbage. Its OBJ reader aborts (an
+// assertion Debian keeps) on a face corner without a vertex index. These readers work on the
+// whole file in memory, check every count against the bytes that are left before anything
+// is allocated, and stop at the first malformed record with its position.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace meshes::detail {
+
+struct RawPolygons {
+  std::vector<Eigen::Vector3f> positions;
+  // Indices as written (0-based for OFF and PLY), range-checked by the caller so that it can
+  // report the first bad face the same way for every format.
+  std::vector<std::int64_t> corners;
+  std::vector<std::size_t> face_offsets{0};  // face f is corners[offsets[f], offsets[f+1])
+};
+
+// Each returns an empty string on success, else the problem (without the path).
+std::string read_off(std::string_view bytes, RawPolygons& out);
+std::string read_ply(std::string_view bytes, RawPolygons& out);
+
+// Checks every 'f' record of an OBJ file before OpenMesh sees it: at least one corner, and
+// each corner v, v/vt, v//vn or v/vt/vn with v a non-zero integer that fits in an int.
+std::string check_obj_faces(std::string_view bytes);
+
+}  // namespace meshes::detail

@@ -1,0 +1,166 @@
+#!/usr/bin/env bash
+# Writes hostile and damaged inputs, runs prtr on each, and regenerates docs/ROBUSTNESS.md:
+# the table of what prtr answers (exit code, first line of the message, time). Every file is
+# made here, from bytes; nothing binary is committed. Needs a built prtr (default
+# build/prtr) and the real inputs for the damaged-copy rows (blender-data).
+#
+#   bash scripts/bad_inputs.sh [PRTR] [OUTPUT.md]
+set -uo pipefail
+cd "$(dirname "$0")/.."
+prtr=$(realpath "${1:-build/prtr}")
+doc=${2:-docs/ROBUSTNESS.md}
+[[ -x $prtr ]] || { echo "bad_inputs: $prtr is not built (cmake --build build --target prtr)" >&2; exit 2; }
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+probe=/usr/share/blender/datafiles/studiolights/world/studio.exr
+
+# le FORMAT VALUES...: little-endian binary through perl's pack (perl-base is essential in
+# Debian); values may be written in hex.
+le() { perl -e 'my $f = shift; print pack($f, map { /^0x/ ? hex($_) : $_ } @ARGV)' "$@"; }
+
+# --- The inputs: file name, command, what it is. -----------------------------------------
+rows=()
+add() { rows+=("$1|$2|$3"); }  # add FILE SUBCOMMAND DESCRIPTION
+
+printf 'f /0' >slash_zero.obj
+add slash_zero.obj mesh "OBJ face corner without a vertex number (4 bytes)"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf /0\n' >late_slash.obj
+add late_slash.obj mesh "the same after valid geometry"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n' >zero_index.obj
+add zero_index.obj mesh "OBJ face with vertex number 0"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n' >bad_index.obj
+add bad_index.obj mesh "OBJ face naming a vertex that does not exist"
+printf 'v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n' >nan.obj
+add nan.obj mesh "OBJ vertex 'nan'"
+printf 'v -3e38 -3e38 0\nv 3e38 -3e38 0\nv -3e38 3e38 0\nf 1 2 3\n' >huge_triangle.obj
+add huge_triangle.obj mesh "finite triangle at +-3e38 (its bounding-box diagonal overflows float)"
+: >empty.obj
+add empty.obj mesh "empty file"
+add missing.obj mesh "no such file"
+mkdir -p folder.obj
+add folder.obj mesh "a directory"
+printf '0 0 0\n' >points.xyz
+add points.xyz mesh "unknown extension"
+
+printf 'OFF\n20000 20000 0\n0 0 0\n' >claims_20k.off
+add claims_20k.off mesh "OFF header claiming 20,000 vertices and faces, one vertex line"
+printf 'OFF\n4000000000 4000000000 0\n0 0 0\n' >claims_4e9.off
+add claims_4e9.off mesh "OFF header claiming 4e9 elements"
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n' >corners.off
+add corners.off mesh "OFF face claiming 4e9 corners"
+printf 'OFF BINARY\n' >binary.off
+add binary.off mesh "binary OFF"
+
+ply_header='ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
+printf "${ply_header}0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n" >nan.ply
+add nan.ply mesh "ASCII PLY with a 'nan' coordinate"
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >claims_4e9.ply
+add claims_4e9.ply mesh "PLY header claiming 4e9 vertices"
+{ printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
+  head -c 36 /dev/zero; printf '\xff'; head -c 12 /dev/zero; } >list.ply
+add list.ply mesh "PLY face list claiming 255 corners, 3 present"
+printf 'this is not a mesh\n' >garbage.ply
+add garbage.ply mesh "text that is not PLY"
+
+{ le vV 0x4d4d 66; le vV 0x3d3d 60; le vV 0x4000 54; printf 'x\0'; le vV 0x4100 46
+  le vV 0x4110 40; le v 9; head -c 32 /dev/zero; } >short_vertices.3ds
+add short_vertices.3ds mesh "3DS vertex list claiming 9 vertices, with room for 2"
+perl -e 'my $n = 20000; for my $d (0..$n) { print pack("vV", 0x4d4d, 6 * ($n + 1 - $d)) }' >deep.3ds
+add deep.3ds mesh "3DS with 20,000 nested main chunks (120 KB)"
+{ le vV 0x4d4d 1000; } >past_end.3ds
+add past_end.3ds mesh "3DS main chunk longer than the file"
+{ head -c 80 /dev/zero; le V 5; head -c 100 /dev/zero; } >short.stl
+add short.stl mesh "binary STL claiming 5 triangles, holding 2"
+
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 20000 +X 40000\n' >huge.hdr
+add huge.hdr probe "53-byte HDR claiming 40000 x 20000"
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1000000000 +X 2000000000\n' >huger.hdr
+add huger.hdr probe "HDR claiming 2e9 x 1e9"
+{ printf '\x76\x2f\x31\x01'; le V 2; printf 'comments\0string\0'; le V 1900000000; head -c 1000 /dev/zero | tr '\0' x; } >attribute.exr
+add attribute.exr probe "1 KB EXR whose string attribute claims 1.9 GB"
+{ printf '\x76\x2f\x31\x01'; le V 2; printf 'owner\0string\0'; le l -5; printf 'abc'; } >negative.exr
+add negative.exr probe "EXR attribute with a negative size"
+{ printf '\x76\x2f\x31\x01'; le V 2; printf 'channels\0chlist\0'; le V 1; printf 'R\0'; head -c 17 /dev/zero
+  printf 'x\0string\0'; le V 1900000000; head -c 100 /dev/zero | tr '\0' x; } >desync.exr
+add desync.exr probe "EXR channel list declaring 1 byte for 19, then an attribute claiming 1.9 GB"
+echo "not an image" >garbage.exr
+add garbage.exr probe "text that is not an image"
+if [[ -f $probe ]]; then
+  head -c 2000 "$probe" >truncated.exr
+  add truncated.exr probe "real EXR cut to 2,000 bytes"
+fi
+add missing.exr probe "no such file"
+
+# Transfer and compressed files: a real one, then damaged copies.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' >tet.obj
+"$prtr" bake tet.obj -o good.prtx --order 2 --samples 16 --bounces 0 --quiet >/dev/null 2>&1
+"$prtr" compress good.prtx --mesh tet.obj -o good.prtc --clusters 1 --pcs 1 --quiet >/dev/null 2>&1
+flip() { local b; b=$(od -An -tu1 -j "$2" -N1 "$1" | tr -d ' '); printf "\\$(printf %03o $((b ^ 255)))" | dd of="$1" bs=1 seek="$2" conv=notrunc status=none; }
+if [[ -f good.prtx ]]; then
+  head -c 100 good.prtx >short.prtx; add short.prtx info "transfer file cut inside its header"
+  cp good.prtx magic.prtx; flip magic.prtx 0; add magic.prtx info "transfer file with a damaged magic number"
+  cp good.prtx payload.prtx; flip payload.prtx 140; add payload.prtx "info --verify" "transfer file with one payload byte flipped"
+  head -c 200 good.prtx >cut.prtx; add cut.prtx info "transfer file cut inside its payload"
+fi
+if [[ -f good.prtc ]]; then
+  cp good.prtc payload.prtc; flip payload.prtc $(($(stat -c %s good.prtc) - 3)); add payload.prtc "info --verify" "compressed file with one payload byte flipped"
+  head -c 150 good.prtc >cut.prtc; add cut.prtc info "compressed file cut after its header"
+fi
+
+# --- Run and tabulate. ----------------------------------------------------------------------
+measure=()
+[[ -x /usr/bin/time ]] && measure=(/usr/bin/time -f '%e %M' -o "$work/time")
+{
+  echo "# Robustness: what prtr does with bad inputs"
+  echo
+  echo "Generated by \`scripts/bad_inputs.sh\` (do not edit by hand): each input is written by"
+  echo "the script from bytes, then given to the command shown. Exit codes: 0 success, 1 failure"
+  echo "(the message names the file and says what to do), 2 usage error. A crash would show as"
+  echo "128 + the signal. Seconds and peak memory (MB) are for the whole command, so they are"
+  echo "mostly process start-up (loading OpenImageIO, Embree and Mesa): what matters is that no"
+  echo "row stands out."
+  echo
+  echo "Size limits behind these answers: mesh readers check every count a header claims"
+  echo "against the bytes left in the file before allocating; probe loading refuses an image"
+  echo "whose decoded size exceeds 4096 times the file size (above 64 MiB) or the free memory,"
+  echo "and any EXR header attribute larger than the file."
+  echo
+  echo "Which reader does what: OFF, PLY and 3DS are read by our own strict readers"
+  echo "(\`meshes/src/read_strict.cpp\`, \`meshes/src/read_3ds.cpp\`; OpenMesh's OFF and PLY readers"
+  echo "size buffers from unchecked counts and read values they never set after a parse error,"
+  echo "which no guard in front of them can fix). OBJ and STL still go through OpenMesh: OBJ"
+  echo "behind a strict pre-pass over its face lines, STL behind our own binary/ASCII decision"
+  echo "by file size. Images go through OpenImageIO behind the checks above."
+  echo
+  echo "The same loaders are fuzzed by \`scripts/fuzz.sh [seconds]\` (libFuzzer, ASan, UBSan;"
+  echo "targets in \`fuzz/\`) and the whole test suite runs under ASan, UBSan and LSan with"
+  echo "\`scripts/sanitize.sh\`."
+  echo
+  echo "| Input | Command | Exit | Seconds | MB | Message (first line) |"
+  echo "|---|---|---|---|---|---|"
+  for row in "${rows[@]}"; do
+    IFS='|' read -r file command what <<<"$row"
+    read -ra sub <<<"$command"
+    rm -f "$work/time"
+    start=$(date +%s.%N)
+    "${measure[@]}" "$prtr" "${sub[@]}" "$file" >/dev/null 2>"$work/err"
+    code=$?
+    end=$(date +%s.%N)
+    seconds=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.2f", b - a }')
+    mb=-
+    if [[ -s $work/time ]]; then
+      mb=$(tail -1 "$work/time" | awk '{ printf "%.0f", $2 / 1024 }')
+      # /usr/bin/time reports a signal on its first line instead of the exit status.
+      grep -q "terminated by signal" "$work/time" && code="$code ($(head -1 "$work/time"))"
+    fi
+    message=$(grep -v '^$' "$work/err" | head -1 | sed "s|$work/||g; s|$work|.|g; s/|/\\\\|/g")
+    ((${#message} > 300)) && message="${message:0:300}..."
+    [[ -z $message ]] && message="(no message)"
+    echo "| $what (\`$file\`) | \`prtr $command\` | $code | $seconds | $mb | $message |"
+  done
+} >"$work/table.md"
+cd - >/dev/null
+mkdir -p "$(dirname "$doc")"
+cp "$work/table.md" "$doc"
+echo "bad_inputs: ${#rows[@]} inputs tabled in $doc" >&2
