@@ -127,6 +127,32 @@ std::optional<prt::TransferSet> load_checked_transfer(const Options& o,
   return transfer;
 }
 
+// The image frame's pipeline statistics: totals, then per draw in draw order.
+std::string work_json(const std::vector<render::PassWork>& work) {
+  const render::WorkTotals t = render::work_totals(work);
+  std::vector<std::uint64_t> vs, ref, prims, fs;
+  std::string labels = "[";
+  for (const render::PassWork& p : work) {
+    vs.push_back(p.vs_invocations);
+    ref.push_back(p.referenced_vertices);
+    prims.push_back(p.primitives);
+    fs.push_back(p.fs_invocations);
+    labels += (labels.size() > 1 ? ",\"" : "\"") + p.label + "\"";
+  }
+  char totals[256];
+  std::snprintf(totals, sizeof totals,
+                "\"vs_invocations\":%llu,\"referenced_vertices\":%llu,"
+                "\"vs_per_referenced_vertex\":%.4f,\"primitives\":%llu,\"fs_invocations\":%llu",
+                (unsigned long long)t.vs_invocations, (unsigned long long)t.referenced_vertices,
+                t.vs_per_referenced_vertex, (unsigned long long)t.primitives,
+                (unsigned long long)t.fs_invocations);
+  return std::string(totals) + ",\"draw_labels\":" + labels +
+         "],\"vs_invocations_per_draw\":" + json_list(vs) +
+         ",\"referenced_vertices_per_draw\":" + json_list(ref) +
+         ",\"primitives_per_draw\":" + json_list(prims) +
+         ",\"fs_invocations_per_draw\":" + json_list(fs);
+}
+
 void print_report(const Options& o, const render::RenderStats& st,
                   const render::TimingSummary& timing) {
   if (!o.quiet) {
@@ -149,10 +175,11 @@ void print_report(const Options& o, const render::RenderStats& st,
     std::printf(
         "{\"mode\":\"%s\",\"width\":%d,\"height\":%d,\"passes\":%d,\"triangles_per_pass\":%s,"
         "\"average_overdraw\":%.6f,\"fps\":%.3f,\"frame_ms_median\":%.3f,"
-        "\"cpu_update_ms\":%.3f,\"gl_ms\":%.3f}\n",
+        "\"cpu_update_ms\":%.3f,\"gl_ms\":%.3f,%s}\n",
         o.mode.c_str(), o.view.width, o.view.height, st.passes,
         json_list(st.triangles_per_pass).c_str(), st.average_overdraw, timing.fps,
-        timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median);
+        timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median,
+        work_json(st.pass_work).c_str());
   }
 }
 
@@ -191,6 +218,7 @@ Runner add_render_command(CLI::App& app) {
     renderer->set_background(background);
     const render::TimingSummary timing = render::measure(
         *renderer, camera, lighting, rotation, axis, o.degrees_per_frame, o.frames, o.warmup);
+    renderer->set_count_work(true);  // the image frame only: timing frames stay unqueried
     renderer->render(camera, lighting, rotation);
     const render::Image image = renderer->read_image();
     render::write_exr(o.output, image);
