@@ -17,6 +17,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -411,6 +412,31 @@ TEST(Renderer, RotatingProbeAndCameraTogetherLeavesTheSphereUnchanged) {
 
 // --- Background ------------------------------------------------------------------------------
 
+// The background's filter: the cubic B-spline of the probe's texels at the lat-long point of
+// direction d (wrapping in u, clamping in v, texel centres at half-integers).
+probes::Rgb bspline_lookup(const probes::Probe& probe, const Eigen::Vector3d& d) {
+  const double theta = std::acos(std::clamp(d.y(), -1.0, 1.0));
+  double phi = std::atan2(-d.x(), d.z());
+  if (phi < 0) phi += 2 * std::numbers::pi;
+  const double px = phi / (2 * std::numbers::pi) * probe.width() - 0.5;
+  const double py = theta / std::numbers::pi * probe.height() - 0.5;
+  const double ix = std::floor(px), iy = std::floor(py);
+  auto weights = [](double f) {
+    return std::array<double, 4>{(1 - f) * (1 - f) * (1 - f) / 6,
+                                 (3 * f * f * f - 6 * f * f + 4) / 6,
+                                 (-3 * f * f * f + 3 * f * f + 3 * f + 1) / 6, f * f * f / 6};
+  };
+  const auto wx = weights(px - ix), wy = weights(py - iy);
+  probes::Rgb sum = probes::Rgb::Zero();
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int x = ((int(ix) - 1 + i) % probe.width() + probe.width()) % probe.width();
+      const int y = std::clamp(int(iy) - 1 + j, 0, probe.height() - 1);
+      sum += float(wx[i] * wy[j]) * probe.texel(x, y);
+    }
+  return sum;
+}
+
 TEST(Renderer, BackgroundIsTheRotatedProbe) {
   render::GlContext ctx;
   Scene s = make_scene(meshes::make_sphere(0.2f, 8, 4), 2, 8, 1);
@@ -419,7 +445,7 @@ TEST(Renderer, BackgroundIsTheRotatedProbe) {
   const render::Image image = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
   for (auto [x, y] : {std::pair{0, 0}, {39, 0}, {0, 29}, {39, 29}, {5, 20}}) {
     const Eigen::Vector3d w = s.camera.pixel_direction(x, y);
-    const probes::Rgb expected = s.probe.lookup(R.transpose() * w);
+    const probes::Rgb expected = bspline_lookup(s.probe, R.transpose() * w);
     const float* px = image.pixel(x, y);
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(px[c], expected[c], 2e-3 * expected.maxCoeff()) << x << "," << y;
@@ -432,6 +458,33 @@ TEST(Renderer, BackgroundIsTheRotatedProbe) {
   const render::Image solid = r.read_image();
   EXPECT_EQ(solid.pixel(0, 0)[0], 0.25f);
   EXPECT_EQ(solid.pixel(0, 0)[2], 0.75f);
+}
+
+// Magnified texels of a checkerboard probe: the image follows the B-spline, and so is not
+// the bilinear lookup (which the smooth test probe above cannot tell apart).
+TEST(Renderer, MagnifiedBackgroundIsBsplineNotBilinear) {
+  render::GlContext ctx;
+  Scene s = make_scene(meshes::make_sphere(0.2f, 8, 4), 2, 8, 1);
+  s.probe = probes::make_from_function(16, 8, [](const Eigen::Vector3d& d) {
+    const double theta = std::acos(std::clamp(d.y(), -1.0, 1.0));
+    const double phi = std::atan2(-d.x(), d.z()) + std::numbers::pi;
+    const bool on = (int(phi / (std::numbers::pi / 8)) + int(theta / (std::numbers::pi / 8))) % 2;
+    return probes::Rgb(on ? 4.f : 0.5f, 1.f, 1.f);
+  });
+  s.camera = render::frame_sphere(Eigen::Vector3d::Zero(), 3.0, 40, 30, 60.0);
+  const Eigen::Matrix3d R = test_rotation();
+  const render::Image image = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
+  double worst_bspline = 0.0, worst_bilinear = 0.0;
+  for (int y = 0; y < 30; y += 3)
+    for (int x = 0; x < 40; x += 3) {
+      const Eigen::Vector3d w = R.transpose() * s.camera.pixel_direction(x, y);
+      const float r = image.pixel(x, y)[0];
+      if (image.pixel(x, y)[3] != 0.f) continue;  // the sphere
+      worst_bspline = std::max(worst_bspline, std::abs(double(r - bspline_lookup(s.probe, w)[0])));
+      worst_bilinear = std::max(worst_bilinear, std::abs(double(r - s.probe.lookup(w)[0])));
+    }
+  EXPECT_LT(worst_bspline, 2e-3 * 4.0);
+  EXPECT_GT(worst_bilinear, 0.1);
 }
 
 TEST(Renderer, SolidBackgroundDoesNotLeakIntoAdditivePasses) {

@@ -257,13 +257,30 @@ std::string background_fragment_shader() {
          "  if (x < 0.0) r = kPi - r;\n"
          "  return y < 0.0 ? -r : r;\n"
          "}\n"
+         // Cubic B-spline from four bilinear taps: magnified ~10x, bilinear HDR texels show
+         // as squares; the B-spline is C2 and never negative (no ringing around the sun).
+         "vec3 probe_bspline(vec2 uv) {\n"
+         "  vec2 size = vec2(textureSize(u_probe, 0));\n"
+         "  vec2 p = uv * size - 0.5;\n"
+         "  vec2 i = floor(p), f = p - i;\n"
+         "  vec2 w0 = (1.0 - f) * (1.0 - f) * (1.0 - f) / 6.0;\n"
+         "  vec2 w1 = (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0;\n"
+         "  vec2 w3 = f * f * f / 6.0;\n"
+         "  vec2 w2 = 1.0 - w0 - w1 - w3;\n"
+         "  vec2 g0 = w0 + w1, g1 = w2 + w3;\n"
+         "  vec2 t0 = (i - 0.5 + w1 / g0) / size, t1 = (i + 1.5 + w3 / g1) / size;\n"
+         "  return g0.y * (g0.x * texture(u_probe, t0).rgb + g1.x * texture(u_probe, vec2(t1.x, "
+         "t0.y)).rgb)\n"
+         "       + g1.y * (g0.x * texture(u_probe, vec2(t0.x, t1.y)).rgb + g1.x * texture(u_probe, "
+         "t1).rgb);\n"
+         "}\n"
          "void main() {\n"
          "  vec3 d = u_probe_from_world * v_direction;\n"
          "  // probes/probe.h: direction(u, v) = (-sin t sin p, cos t, sin t cos p).\n"
          "  float theta = atan2_fast(length(d.xz), d.y);\n"
          "  float phi = atan2_fast(-d.x, d.z);\n"
          "  if (phi < 0.0) phi += 2.0 * kPi;\n"
-         "  o_colour = vec4(texture(u_probe, vec2(phi / (2.0 * kPi), theta / kPi)).rgb, 0.0);\n"
+         "  o_colour = vec4(probe_bspline(vec2(phi / (2.0 * kPi), theta / kPi)), 0.0);\n"
          "}\n";
 }
 
