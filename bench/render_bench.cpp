@@ -10,6 +10,7 @@
 // frames with glFinish, and lighting rotates every frame so constants are recomputed inside
 // the timing.
 #include "cpca/compressed_file.h"
+#include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
 #include "probes/load.h"
 #include "prt/projection.h"
@@ -19,10 +20,13 @@
 #include "render/gl_context.h"
 #include "render/renderer.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 int main(int argc, char** argv) {
   if (argc < 2) {
@@ -69,41 +73,110 @@ int main(int argc, char** argv) {
         "%d x %d, %d frames (median)\n",
         compressed.c_str(), mesh.vertex_count(), mesh.triangle_count(), set.cluster_count,
         set.component_count, set.order, width, height, frames);
-    const double floor_ms = render::floor_frame_ms(mesh, camera, {true, true, frames, 3});
+    // Every floor draws into the renderer's framebuffer format; "+ background" also runs the
+    // renderer's probe background pass, so a path's ratio to it compares like with like.
+    std::vector<render::PassWork> floor_work, floor_bg_work;
+    const double floor_ms =
+        render::floor_frame_ms(mesh, camera, {true, true, frames, 3, nullptr, &floor_work});
+    const double floor_bg =
+        render::floor_frame_ms(mesh, camera, {true, true, frames, 3, &probe, &floor_bg_work});
     const double floor_plain = render::floor_frame_ms(mesh, camera, {false, false, frames, 3});
-    std::printf("%-28s %7s %9s %8s %9s %8s %8s %7s\n", "configuration", "passes", "overdraw", "FPS",
-                "frame ms", "cpu ms", "gl ms", "/floor");
-    std::printf("%-28s %7d %9.3f %8.2f %9.2f %8s %8s %7.2f\n", "floor (trivial, cull+order)", 1,
-                1.0, 1000.0 / floor_ms, floor_ms, "-", "-", 1.0);
-    std::printf("%-28s %7d %9.3f %8.2f %9.2f %8s %8s %7.2f\n", "floor (trivial, plain)", 1, 1.0,
-                1000.0 / floor_plain, floor_plain, "-", "-", floor_plain / floor_ms);
+    std::printf("%-28s %6s %8s %7s %8s %7s %7s %6s %6s %9s %9s %6s %10s\n", "configuration",
+                "passes", "overdraw", "FPS", "frame ms", "cpu ms", "gl ms", "/floor", "/fl+bg",
+                "VS inv", "ref verts", "VS/ref", "FS inv");
+    auto print_work = [](const std::vector<render::PassWork>& work) {
+      const render::WorkTotals w = render::work_totals(work);
+      std::printf(" %9llu %9llu %6.3f %10llu\n", (unsigned long long)w.vs_invocations,
+                  (unsigned long long)w.referenced_vertices, w.vs_per_referenced_vertex,
+                  (unsigned long long)w.fs_invocations);
+    };
+    auto mesh_only = [](std::vector<render::PassWork> work) {  // VS/ref without the quad
+      std::erase_if(work, [](const render::PassWork& p) { return p.label == "background"; });
+      return work;
+    };
+    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f", "floor (trivial, cull+order)", 1,
+                1.0, 1000.0 / floor_ms, floor_ms, "-", "-", 1.0, floor_ms / floor_bg);
+    print_work(floor_work);
+    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f", "floor + background", 1, 1.0,
+                1000.0 / floor_bg, floor_bg, "-", "-", floor_bg / floor_ms, 1.0);
+    print_work(floor_bg_work);
+    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f\n", "floor (trivial, plain)", 1,
+                1.0, 1000.0 / floor_plain, floor_plain, "-", "-", floor_plain / floor_ms,
+                floor_plain / floor_bg);
     struct Row {
       const char* name;
       render::Mode mode;
       int clusters_per_pass;
+      const char* strategy = nullptr;  // cpca::group_clusters name; null: cluster order
     };
+    // The thesis configuration is the ILS row: 3 clusters per pass grouped by ILS.
     const Row rows[] = {{"multipass, context budget", render::Mode::kMultipass, 0},
                         {"multipass, 3 clusters/pass", render::Mode::kMultipass, 3},
+                        {"multipass, 3/pass, ILS", render::Mode::kMultipass, 3, "ils"},
                         {"decoupled, 3 clusters/pass", render::Mode::kDecoupled, 3},
                         {"single-pass (SSBO)", render::Mode::kSinglepass, 0},
                         {"uncompressed", render::Mode::kUncompressed, 0},
                         {"cpu-shaded", render::Mode::kCpu, 0}};
-    for (const Row& row : rows) {
-      if (row.mode == render::Mode::kUncompressed && !transfer) {
-        std::printf("%-28s (skipped: pass --transfer)\n", row.name);
-        continue;
+    std::vector<std::pair<std::string, std::vector<render::PassWork>>> details;
+    // Each path twice: with the earlier vertex numbering (", old #") and with first-use
+    // numbering, so the effect of renumbering is a ratio within this run.
+    for (const Row& row : rows)
+      for (bool renumber : {false, true}) {
+        if (row.mode == render::Mode::kUncompressed && !transfer) {
+          if (renumber) std::printf("%-28s (skipped: pass --transfer)\n", row.name);
+          continue;
+        }
+        const std::string name = std::string(row.name) + (renumber ? "" : ", old #");
+        render::RendererOptions o;
+        o.renumber_vertices = renumber;
+        o.mode = row.mode;
+        o.clusters_per_pass = row.clusters_per_pass;
+        if (row.strategy) {
+          std::vector<cpca::TriangleIndices> tris(mesh.triangles.begin(), mesh.triangles.end());
+          o.groups = cpca::group_clusters(
+              row.strategy, {set.cluster_of, tris, set.cluster_count, row.clusters_per_pass});
+        }
+        render::Renderer r(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
+        const render::TimingSummary t =
+            render::measure(r, camera, lighting, Eigen::Matrix3d::Identity(),
+                            Eigen::Vector3d::UnitY(), 1.0, frames, 3);
+        r.set_count_work(true);
+        r.render(camera, lighting, Eigen::Matrix3d::Identity());
+        std::printf("%-28s %6d %8.3f %7.2f %8.2f %7.2f %7.2f %6.2f %6.2f", name.c_str(),
+                    r.stats().passes, r.stats().average_overdraw, t.fps, t.frame_ms_median,
+                    t.cpu_ms_median, t.gl_ms_median, t.frame_ms_median / floor_ms,
+                    t.frame_ms_median / floor_bg);
+        print_work(mesh_only(r.stats().pass_work));
+        details.emplace_back(name, r.stats().pass_work);
+        std::fflush(stdout);
       }
-      render::RendererOptions o;
-      o.mode = row.mode;
-      o.clusters_per_pass = row.clusters_per_pass;
-      render::Renderer r(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
-      const render::TimingSummary t =
-          render::measure(r, camera, lighting, Eigen::Matrix3d::Identity(),
-                          Eigen::Vector3d::UnitY(), 1.0, frames, 3);
-      std::printf("%-28s %7d %9.3f %8.2f %9.2f %8.2f %8.2f %7.2f\n", row.name, r.stats().passes,
-                  r.stats().average_overdraw, t.fps, t.frame_ms_median, t.cpu_ms_median,
-                  t.gl_ms_median, t.frame_ms_median / floor_ms);
-      std::fflush(stdout);
+    // Per draw, so a path's waste can be traced to the draw that has it; multipass shading
+    // passes as one line (their sum, and the worst pass).
+    std::printf("\nper draw: VS invocations / referenced vertices (primitives, FS invocations)\n");
+    for (const auto& [name, work] : details) {
+      std::printf("%s:\n", name.c_str());
+      std::vector<render::PassWork> shade;
+      double worst = 0;
+      for (const render::PassWork& p : work) {
+        const double ratio =
+            p.referenced_vertices ? double(p.vs_invocations) / double(p.referenced_vertices) : 0.0;
+        if (p.label.starts_with("shade ")) {
+          shade.push_back(p);
+          worst = std::max(worst, ratio);
+          continue;
+        }
+        std::printf("  %-12s %8llu / %7llu = %6.3f  (%llu prims, %llu FS)\n", p.label.c_str(),
+                    (unsigned long long)p.vs_invocations, (unsigned long long)p.referenced_vertices,
+                    ratio, (unsigned long long)p.primitives, (unsigned long long)p.fs_invocations);
+      }
+      if (!shade.empty()) {
+        const render::WorkTotals t = render::work_totals(shade);
+        std::printf(
+            "  %zu passes   %8llu / %7llu = %6.3f  (%llu prims, %llu FS; worst pass %.3f)\n",
+            shade.size(), (unsigned long long)t.vs_invocations,
+            (unsigned long long)t.referenced_vertices, t.vs_per_referenced_vertex,
+            (unsigned long long)t.primitives, (unsigned long long)t.fs_invocations, worst);
+      }
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render_bench: %s\n", e.what());

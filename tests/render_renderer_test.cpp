@@ -12,10 +12,12 @@
 #include "render/floor_harness.h"
 #include "render/gl_context.h"
 
+#include <GL/gl.h>
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -420,6 +422,31 @@ TEST(Renderer, RotatingProbeAndCameraTogetherLeavesTheSphereUnchanged) {
 
 // --- Background ------------------------------------------------------------------------------
 
+// The background's filter: the cubic B-spline of the probe's texels at the lat-long point of
+// direction d (wrapping in u, clamping in v, texel centres at half-integers).
+probes::Rgb bspline_lookup(const probes::Probe& probe, const Eigen::Vector3d& d) {
+  const double theta = std::acos(std::clamp(d.y(), -1.0, 1.0));
+  double phi = std::atan2(-d.x(), d.z());
+  if (phi < 0) phi += 2 * std::numbers::pi;
+  const double px = phi / (2 * std::numbers::pi) * probe.width() - 0.5;
+  const double py = theta / std::numbers::pi * probe.height() - 0.5;
+  const double ix = std::floor(px), iy = std::floor(py);
+  auto weights = [](double f) {
+    return std::array<double, 4>{(1 - f) * (1 - f) * (1 - f) / 6,
+                                 (3 * f * f * f - 6 * f * f + 4) / 6,
+                                 (-3 * f * f * f + 3 * f * f + 3 * f + 1) / 6, f * f * f / 6};
+  };
+  const auto wx = weights(px - ix), wy = weights(py - iy);
+  probes::Rgb sum = probes::Rgb::Zero();
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const int x = ((int(ix) - 1 + i) % probe.width() + probe.width()) % probe.width();
+      const int y = std::clamp(int(iy) - 1 + j, 0, probe.height() - 1);
+      sum += float(wx[i] * wy[j]) * probe.texel(x, y);
+    }
+  return sum;
+}
+
 TEST(Renderer, BackgroundIsTheRotatedProbe) {
   render::GlContext ctx;
   Scene s = make_scene(meshes::make_sphere(0.2f, 8, 4), 2, 8, 1);
@@ -428,7 +455,7 @@ TEST(Renderer, BackgroundIsTheRotatedProbe) {
   const render::Image image = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
   for (auto [x, y] : {std::pair{0, 0}, {39, 0}, {0, 29}, {39, 29}, {5, 20}}) {
     const Eigen::Vector3d w = s.camera.pixel_direction(x, y);
-    const probes::Rgb expected = s.probe.lookup(R.transpose() * w);
+    const probes::Rgb expected = bspline_lookup(s.probe, R.transpose() * w);
     const float* px = image.pixel(x, y);
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(px[c], expected[c], 2e-3 * expected.maxCoeff()) << x << "," << y;
@@ -441,6 +468,33 @@ TEST(Renderer, BackgroundIsTheRotatedProbe) {
   const render::Image solid = r.read_image();
   EXPECT_EQ(solid.pixel(0, 0)[0], 0.25f);
   EXPECT_EQ(solid.pixel(0, 0)[2], 0.75f);
+}
+
+// Magnified texels of a checkerboard probe: the image follows the B-spline, and so is not
+// the bilinear lookup (which the smooth test probe above cannot tell apart).
+TEST(Renderer, MagnifiedBackgroundIsBsplineNotBilinear) {
+  render::GlContext ctx;
+  Scene s = make_scene(meshes::make_sphere(0.2f, 8, 4), 2, 8, 1);
+  s.probe = probes::make_from_function(16, 8, [](const Eigen::Vector3d& d) {
+    const double theta = std::acos(std::clamp(d.y(), -1.0, 1.0));
+    const double phi = std::atan2(-d.x(), d.z()) + std::numbers::pi;
+    const bool on = (int(phi / (std::numbers::pi / 8)) + int(theta / (std::numbers::pi / 8))) % 2;
+    return probes::Rgb(on ? 4.f : 0.5f, 1.f, 1.f);
+  });
+  s.camera = render::frame_sphere(Eigen::Vector3d::Zero(), 3.0, 40, 30, 60.0);
+  const Eigen::Matrix3d R = test_rotation();
+  const render::Image image = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
+  double worst_bspline = 0.0, worst_bilinear = 0.0;
+  for (int y = 0; y < 30; y += 3)
+    for (int x = 0; x < 40; x += 3) {
+      const Eigen::Vector3d w = R.transpose() * s.camera.pixel_direction(x, y);
+      const float r = image.pixel(x, y)[0];
+      if (image.pixel(x, y)[3] != 0.f) continue;  // the sphere
+      worst_bspline = std::max(worst_bspline, std::abs(double(r - bspline_lookup(s.probe, w)[0])));
+      worst_bilinear = std::max(worst_bilinear, std::abs(double(r - s.probe.lookup(w)[0])));
+    }
+  EXPECT_LT(worst_bspline, 2e-3 * 4.0);
+  EXPECT_GT(worst_bilinear, 0.1);
 }
 
 TEST(Renderer, SolidBackgroundDoesNotLeakIntoAdditivePasses) {
@@ -508,3 +562,75 @@ TEST(Renderer, RejectsBudgetsBelowOneCluster) {
 }
 
 }  // namespace
+
+// --- Pipeline statistics -------------------------------------------------------------------
+
+// The counters' oracles: a draw submits exactly its triangles, no draw shades fewer vertices
+// than it references, and the decoupled feedback draw shades each vertex exactly once.
+TEST(Renderer, WorkCountersMatchTheDrawsTheyBracket) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 3, 10, 2);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  for (render::Mode mode : {render::Mode::kMultipass, render::Mode::kSinglepass,
+                            render::Mode::kDecoupled, render::Mode::kCpu}) {
+    render::RendererOptions o = options(mode, 3 * registers);
+    o.count_work = true;
+    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
+    r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
+    const render::RenderStats& st = r.stats();
+    ASSERT_FALSE(st.pass_work.empty()) << render::mode_name(mode);
+    std::uint64_t shaded_triangles = 0;
+    for (const render::PassWork& p : st.pass_work) {
+      if (p.label == "background") {
+        EXPECT_EQ(p.primitives, 1u);
+        EXPECT_GT(p.fs_invocations, 0u);
+        continue;
+      }
+      EXPECT_GE(p.vs_invocations, p.referenced_vertices) << render::mode_name(mode) << p.label;
+      if (p.label == "feedback") {
+        EXPECT_EQ(p.vs_invocations, s.mesh.vertex_count());
+        EXPECT_EQ(p.primitives, s.mesh.vertex_count());
+      } else if (p.label.starts_with("shade")) {
+        shaded_triangles += p.primitives;
+      } else {
+        EXPECT_EQ(p.label, "depth");
+        EXPECT_EQ(p.primitives, s.mesh.triangle_count());
+      }
+    }
+    std::uint64_t predicted = 0;
+    for (std::uint64_t t : st.triangles_per_pass) predicted += t;
+    EXPECT_EQ(shaded_triangles, predicted) << render::mode_name(mode);
+    const render::WorkTotals totals = render::work_totals(st.pass_work);
+    EXPECT_GE(totals.vs_per_referenced_vertex, 1.0);
+  }
+}
+
+// --- GL debug output -------------------------------------------------------------------------
+
+// Every path renders and captures without a KHR_debug error or undefined-behaviour message
+// (the decoupled path once fed back into a buffer its VAO still sourced). The log itself is
+// checked first: a deliberate invalid enum must reach it.
+TEST(Renderer, EveryModeRunsWithoutDebugErrors) {
+  render::GlContext ctx;
+  {
+    render::GlDebugLog probe_log;
+    glEnable(0xFFFF);  // not a capability: GL_INVALID_ENUM
+    EXPECT_FALSE(probe_log.messages().empty()) << "KHR_debug output is not delivered";
+    while (glGetError() != GL_NO_ERROR) {
+    }
+  }
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 3, 10, 2);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  for (render::Mode mode :
+       {render::Mode::kMultipass, render::Mode::kSinglepass, render::Mode::kDecoupled,
+        render::Mode::kUncompressed, render::Mode::kCpu}) {
+    render::GlDebugLog log;
+    render::RendererOptions o = options(mode, 3 * registers);
+    o.count_work = true;
+    render::Renderer r(s.mesh, &s.set, &s.transfer, &s.probe, o);
+    r.render(s.camera, s.lighting, test_rotation());
+    r.capture_vertex_radiance(s.camera, s.lighting, test_rotation());
+    for (const std::string& m : log.messages())
+      ADD_FAILURE() << render::mode_name(mode) << ": " << m;
+  }
+}

@@ -18,6 +18,7 @@
 #include "render/gl_context.h"
 #include "render/image.h"
 #include "render/renderer.h"
+#include "render/supersample.h"
 
 #include <cstdio>
 #include <memory>
@@ -41,6 +42,8 @@ struct Options {
   ViewFlags view;
   double rotate_deg = 0.0, degrees_per_frame = 1.0;
   int register_budget = 0, clusters_per_pass = 0, frames = 20, warmup = 3;
+  // The written image only: timing frames stay at --width x --height.
+  int supersample = 2;
   bool json = false, quiet = false, no_cull = false, no_reorder = false;
 };
 
@@ -50,6 +53,11 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("-o,--output", o.output, "EXR to write (linear RGB, alpha = coverage)")
       ->required();
   cmd->add_option("--png", o.png, "Also write a tone-mapped PNG");
+  cmd->add_option("--supersample", o.supersample,
+                  "Anti-aliasing of the written image: render N x N samples per pixel and "
+                  "box-filter (1: off)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   cmd->add_option("--mesh", o.mesh, "Mesh (default: the one the set was baked from)");
   cmd->add_option("--mode", o.mode, "Rendering path")
       ->check(CLI::IsMember(render::mode_names()))
@@ -127,8 +135,32 @@ std::optional<prt::TransferSet> load_checked_transfer(const Options& o,
   return transfer;
 }
 
+// The image frame's pipeline statistics: totals, then per draw in draw order.
+void add_work(Json& line, const std::vector<render::PassWork>& work) {
+  const render::WorkTotals t = render::work_totals(work);
+  line["vs_invocations"] = t.vs_invocations;
+  line["referenced_vertices"] = t.referenced_vertices;
+  line["vs_per_referenced_vertex"] = t.vs_per_referenced_vertex;
+  line["primitives"] = t.primitives;
+  line["fs_invocations"] = t.fs_invocations;
+  Json labels = Json::array(), vs = Json::array(), ref = Json::array(), prims = Json::array(),
+       fs = Json::array();
+  for (const render::PassWork& p : work) {
+    labels.push_back(p.label);
+    vs.push_back(p.vs_invocations);
+    ref.push_back(p.referenced_vertices);
+    prims.push_back(p.primitives);
+    fs.push_back(p.fs_invocations);
+  }
+  line["draw_labels"] = labels;
+  line["vs_invocations_per_draw"] = vs;
+  line["referenced_vertices_per_draw"] = ref;
+  line["primitives_per_draw"] = prims;
+  line["fs_invocations_per_draw"] = fs;
+}
+
 void print_report(const Options& o, const render::RenderStats& st,
-                  const render::TimingSummary& timing) {
+                  const render::TimingSummary& timing, double image_ms) {
   if (!o.quiet) {
     std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
                 o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
@@ -144,18 +176,23 @@ void print_report(const Options& o, const render::RenderStats& st,
         "frames\n",
         timing.fps, timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median,
         timing.frames);
+    std::printf("image       %d x %d samples per pixel, %.2f ms for the written frame\n",
+                o.supersample, o.supersample, image_ms);
   }
   if (o.json) {
-    const Json line = {{"mode", o.mode},
-                       {"width", o.view.width},
-                       {"height", o.view.height},
-                       {"passes", st.passes},
-                       {"triangles_per_pass", st.triangles_per_pass},
-                       {"average_overdraw", st.average_overdraw},
-                       {"fps", timing.fps},
-                       {"frame_ms_median", timing.frame_ms_median},
-                       {"cpu_update_ms", timing.cpu_ms_median},
-                       {"gl_ms", timing.gl_ms_median}};
+    Json line = {{"mode", o.mode},
+                 {"width", o.view.width},
+                 {"height", o.view.height},
+                 {"passes", st.passes},
+                 {"triangles_per_pass", st.triangles_per_pass},
+                 {"average_overdraw", st.average_overdraw},
+                 {"fps", timing.fps},
+                 {"frame_ms_median", timing.frame_ms_median},
+                 {"cpu_update_ms", timing.cpu_ms_median},
+                 {"gl_ms", timing.gl_ms_median}};
+    add_work(line, st.pass_work);
+    line["supersample"] = o.supersample;
+    line["image_frame_ms"] = image_ms;
     std::printf("%s\n", dump_json(line).c_str());
   }
 }
@@ -195,16 +232,21 @@ Runner add_render_command(CLI::App& app) {
     renderer->set_background(background);
     const render::TimingSummary timing = render::measure(
         *renderer, camera, lighting, rotation, axis, o.degrees_per_frame, o.frames, o.warmup);
+    renderer->set_count_work(true);  // one counted frame at the timed size
     renderer->render(camera, lighting, rotation);
-    const render::Image image = renderer->read_image();
+    const render::RenderStats counted = renderer->stats();
+    renderer->set_count_work(false);
+    const render::Camera image_camera = render::supersampled(camera, o.supersample);
+    const double image_ms = renderer->render(image_camera, lighting, rotation).total_ms;
+    const render::Image image = render::box_downsample(renderer->read_image(), o.supersample);
     render::write_exr(o.output, image);
     if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
-    const render::RenderStats& st = renderer->stats();
+    const render::RenderStats& st = counted;
     if (!st.measured_triangles.empty() && st.measured_triangles != st.triangles_per_pass)
       throw std::runtime_error("GL counted " + count_list(st.measured_triangles) +
                                " triangles per pass but the grouping predicts " +
                                count_list(st.triangles_per_pass) + " (a renderer bug)");
-    print_report(o, st, timing);
+    print_report(o, st, timing, image_ms);
   };
 }
 

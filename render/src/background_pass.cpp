@@ -1,7 +1,10 @@
 #include "background_pass.h"
 
 #include "render/gl_context.h"
+#include "render/glm_eigen.h"
 #include "render/shader_source.h"
+
+#include <glm/gtc/type_ptr.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -49,17 +52,18 @@ void BackgroundPass::draw(const Camera& camera, const Eigen::Matrix3d& rotation)
   glDepthMask(GL_FALSE);
   glDisable(GL_CULL_FACE);
   // The world ray is affine in screen position, so the corners' rays interpolate exactly.
-  const Eigen::Vector3d f = (camera.target - camera.eye).normalized();
-  const Eigen::Vector3d r = f.cross(camera.up).normalized();
-  const Eigen::Vector3d u = r.cross(f);
-  const double t = std::tan(0.5 * camera.fov_y_degrees * std::numbers::pi / 180.0);
-  const Eigen::Vector3f ff = f.cast<float>(), rr = (r * t * camera.aspect()).cast<float>(),
-                        uu = (u * t).cast<float>();
-  glUniform3fv(program_.uniform("u_forward"), 1, ff.data());
-  glUniform3fv(program_.uniform("u_right"), 1, rr.data());
-  glUniform3fv(program_.uniform("u_up"), 1, uu.data());
-  const Eigen::Matrix3f probe_from_world = rotation.transpose().cast<float>();
-  glUniformMatrix3fv(program_.uniform("u_probe_from_world"), 1, GL_FALSE, probe_from_world.data());
+  const glm::dvec3 f = glm::normalize(to_glm(camera.target) - to_glm(camera.eye));
+  const glm::dvec3 r = glm::normalize(glm::cross(f, to_glm(camera.up)));
+  const glm::dvec3 u = glm::cross(r, f);
+  const double t = std::tan(0.5 * glm::radians(camera.fov_y_degrees));
+  const glm::vec3 ff(f), rr(r * t * camera.aspect()), uu(u * t);
+  glUniform3fv(program_.uniform("u_forward"), 1, glm::value_ptr(ff));
+  glUniform3fv(program_.uniform("u_right"), 1, glm::value_ptr(rr));
+  glUniform3fv(program_.uniform("u_up"), 1, glm::value_ptr(uu));
+  // Radiance toward w is probe(R^T w).
+  const glm::mat3 probe_from_world(glm::transpose(glm::dmat3(to_glm(rotation))));
+  glUniformMatrix3fv(program_.uniform("u_probe_from_world"), 1, GL_FALSE,
+                     glm::value_ptr(probe_from_world));
   glActiveTexture(GL_TEXTURE0);
   glBindTexture(GL_TEXTURE_2D, texture_);
   glUniform1i(program_.uniform("u_probe"), 0);

@@ -1,5 +1,9 @@
 #include "render/camera.h"
 
+#include "render/glm_eigen.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -35,30 +39,14 @@ void Camera::validate() const {
     throw std::invalid_argument("camera clip planes must satisfy 0 < near < far");
 }
 
+// GLM owns the GL conventions (right-handed, clip z in [-w, w]); Eigen keeps the interface
+// the numerics use (render/glm_eigen.h).
 Eigen::Matrix4d Camera::view_from_world() const {
-  const Eigen::Vector3d f = (target - eye).normalized();
-  const Eigen::Vector3d r = f.cross(up).normalized();
-  const Eigen::Vector3d u = r.cross(f);
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.block<1, 3>(0, 0) = r.transpose();
-  m.block<1, 3>(1, 0) = u.transpose();
-  m.block<1, 3>(2, 0) = -f.transpose();
-  m(0, 3) = -r.dot(eye);
-  m(1, 3) = -u.dot(eye);
-  m(2, 3) = f.dot(eye);
-  return m;
+  return to_eigen(glm::lookAt(to_glm(eye), to_glm(target), to_glm(up)));
 }
 
 Eigen::Matrix4d Camera::clip_from_view() const {
-  const double t = tan_half_fov(fov_y_degrees);
-  const double n = near_plane, f = far_plane;
-  Eigen::Matrix4d m = Eigen::Matrix4d::Zero();
-  m(0, 0) = 1.0 / (t * aspect());
-  m(1, 1) = 1.0 / t;
-  m(2, 2) = -(f + n) / (f - n);
-  m(2, 3) = -2.0 * f * n / (f - n);
-  m(3, 2) = -1.0;
-  return m;
+  return to_eigen(glm::perspective(glm::radians(fov_y_degrees), aspect(), near_plane, far_plane));
 }
 
 Eigen::Vector3d Camera::pixel_direction(double x, double y) const {

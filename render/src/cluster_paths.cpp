@@ -103,15 +103,32 @@ SlotPlan plan_slots(cpca::SuperClusters groups, int cluster_count, int registers
 // with per-vertex slot, pass and weights.
 class ClusterPath : public RenderPath {
  public:
-  // `sort_by_slot`: store vertices sorted by constant slot (each cluster one vertex range).
-  ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot)
+  // `sort_by_slot`: store vertices sorted by constant slot (each cluster one vertex range),
+  // in first-use order within a slot. `pass_blocks`: after the whole mesh, a block of copies
+  // per pass of the vertices its triangles reference, each in the pass's own first-use order,
+  // so every pass draws consecutive indices (pass_lists_).
+  // `legacy_sort`: the slot sort this path had before renumbering (renumber_vertices off).
+  ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot,
+              bool pass_blocks, bool legacy_sort)
       : constants_(*in.set), layout_(constants_.layout()) {
     const int per_pass = clusters_per_pass(in, layout_.registers_per_cluster());
     plan_ = plan_slots(group(in, per_pass, split), in.set->cluster_count,
                        layout_.registers_per_cluster(), per_cluster_aligned);
     host_.assign(std::size_t(plan_.total_slots) * layout_.floats_stride(), 0.f);
-    mesh_ = std::make_unique<GpuMesh>(in.mesh, vertex_order(*in.set, sort_by_slot),
-                                      in.options.optimize_vertex_cache);
+    const bool optimize = in.options.optimize_vertex_cache;
+    const bool renumber = in.options.renumber_vertices;
+    std::vector<std::uint32_t> order =
+        vertex_order(in.mesh, *in.set, renumber ? sort_by_slot : legacy_sort, optimize, renumber);
+    if (pass_blocks) {
+      std::vector<cpca::TriangleIndices> tris(in.mesh.triangles.begin(), in.mesh.triangles.end());
+      for (const auto& ids : cpca::triangles_per_pass(in.set->cluster_of, tris, plan_.groups)) {
+        if (renumber)
+          pass_lists_.push_back(append_vertex_block(in.mesh, ids, optimize, order));
+        else
+          pass_triangles_.push_back(ids);
+      }
+    }
+    mesh_ = std::make_unique<GpuMesh>(in.mesh, std::move(order), optimize);
     gpu_set_ = reordered_set(*in.set);
     pass_of_vertex_.assign(mesh_->vertex_count(), 0);
     if (!plan_.groups.pass_of.empty())
@@ -129,11 +146,11 @@ class ClusterPath : public RenderPath {
  protected:
   // The per-vertex attributes, the index ranges (whole mesh, then `pass_lists`), and the
   // constant buffer bound as `target`.
-  void upload(const std::vector<std::uint32_t>& cluster_attribute,
-              const std::vector<std::vector<std::uint32_t>>& pass_lists, GLenum target,
+  void upload(const std::vector<std::uint32_t>& cluster_attribute, GLenum target,
               bool shaded_on_gpu) {
     whole_ = mesh_->add_all_triangles();
-    for (const auto& list : pass_lists) pass_ranges_.push_back(mesh_->add_triangles(list));
+    for (const auto& list : pass_lists_) pass_ranges_.push_back(mesh_->add_indices(list));
+    for (const auto& ids : pass_triangles_) pass_ranges_.push_back(mesh_->add_triangles(ids));
     mesh_->uint_attribute(kAttrCluster, cluster_attribute);
     mesh_->uint_attribute(kAttrPass, pass_of_vertex_);
     const int N = gpu_set_.component_count;
@@ -160,18 +177,27 @@ class ClusterPath : public RenderPath {
   cpca::CompressedSet gpu_set_;  // in GPU vertex order; cluster_of holds slots, not ids
   std::vector<float> host_;
   std::vector<std::uint32_t> pass_of_vertex_;
+  std::vector<std::vector<std::uint32_t>> pass_lists_;      // GPU indices, one per pass
+  std::vector<std::vector<std::uint32_t>> pass_triangles_;  // without renumbering
   std::vector<IndexRange> pass_ranges_;
   GLuint constant_buffer_ = 0;
   GLenum constant_target_ = GL_UNIFORM_BUFFER;
 
  private:
-  std::vector<std::uint32_t> vertex_order(const cpca::CompressedSet& set, bool sort) const {
+  std::vector<std::uint32_t> vertex_order(const meshes::Mesh& mesh, const cpca::CompressedSet& set,
+                                          bool sort, bool optimize, bool renumber) const {
+    std::vector<std::uint32_t> rank(set.vertex_count);
+    if (renumber)
+      rank = first_use_rank(mesh, optimize);
+    else
+      std::iota(rank.begin(), rank.end(), 0u);
     std::vector<std::uint32_t> order(set.vertex_count);
     std::iota(order.begin(), order.end(), 0u);
-    if (sort)
-      std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return plan_.slot_of[set.cluster_of[a]] < plan_.slot_of[set.cluster_of[b]];
-      });
+    auto key = [&](std::uint32_t v) {
+      return std::pair(sort ? plan_.slot_of[set.cluster_of[v]] : 0u, rank[v]);
+    };
+    std::sort(order.begin(), order.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
     return order;
   }
 
@@ -196,7 +222,7 @@ class ClusterPath : public RenderPath {
 // its clusters' constants as one UBO range and drawing only its own triangles.
 class MultipassPath : public ClusterPath {
  public:
-  explicit MultipassPath(const PathInput& in) : ClusterPath(in, true, false, true) {
+  explicit MultipassPath(const PathInput& in) : ClusterPath(in, true, false, false, true, true) {
     std::vector<cpca::TriangleIndices> tris(in.mesh.triangles.begin(), in.mesh.triangles.end());
     const cpca::OverdrawStats od = cpca::overdraw(in.set->cluster_of, tris, plan_.groups);
     in.stats.triangles_per_pass = od.triangles_per_pass;
@@ -206,8 +232,7 @@ class MultipassPath : public ClusterPath {
     std::vector<std::uint32_t> relative = slots();
     for (std::size_t i = 0; i < relative.size(); ++i)
       relative[i] -= std::uint32_t(plan_.pass_offset[pass_of_vertex_[i]] / cluster_bytes());
-    upload(relative, cpca::triangles_per_pass(in.set->cluster_of, tris, plan_.groups),
-           GL_UNIFORM_BUFFER, true);
+    upload(relative, GL_UNIFORM_BUFFER, true);
     depth_program_ =
         GlProgram("depth pre-pass", position_vertex_shader(), coverage_fragment_shader());
     shade_program_ = GlProgram(
@@ -223,7 +248,9 @@ class MultipassPath : public ClusterPath {
     set_camera_uniforms(depth_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);  // rgb = 0, alpha = coverage
     glDepthFunc(GL_LESS);
+    begin_work("depth", whole_.referenced);
     mesh_->draw(whole_);
+    end_work();
     set_camera_uniforms(shade_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
     glDepthFunc(GL_EQUAL);
@@ -234,7 +261,9 @@ class MultipassPath : public ClusterPath {
       if (pass_ranges_[p].count == 0) continue;
       bind_pass(p);
       if (!queries.empty()) glBeginQuery(GL_PRIMITIVES_GENERATED, queries[p]);
+      begin_work("shade " + std::to_string(p), pass_ranges_[p].referenced);
       mesh_->draw(pass_ranges_[p]);
+      end_work();
       if (!queries.empty()) glEndQuery(GL_PRIMITIVES_GENERATED);
     }
     glDisable(GL_BLEND);
@@ -264,8 +293,8 @@ class MultipassPath : public ClusterPath {
 // All clusters' constants in one SSBO indexed by the vertex's slot; one draw.
 class SinglepassPath : public ClusterPath {
  public:
-  explicit SinglepassPath(const PathInput& in) : ClusterPath(in, false, false, true) {
-    upload(slots(), {}, GL_SHADER_STORAGE_BUFFER, true);
+  explicit SinglepassPath(const PathInput& in) : ClusterPath(in, false, false, false, false, true) {
+    upload(slots(), GL_SHADER_STORAGE_BUFFER, true);
     program_ = GlProgram("single-pass shading",
                          compressed_vertex_shader(layout_, ConstantAccess::kStorage, 0, false),
                          radiance_fragment_shader(), true);
@@ -288,8 +317,8 @@ class SinglepassPath : public ClusterPath {
 // feedback writes the radiance in place; then one pass-through draw of all triangles.
 class DecoupledPath : public ClusterPath {
  public:
-  explicit DecoupledPath(const PathInput& in) : ClusterPath(in, true, true, true) {
-    upload(slots(), {}, GL_UNIFORM_BUFFER, true);
+  explicit DecoupledPath(const PathInput& in) : ClusterPath(in, true, true, true, false, true) {
+    upload(slots(), GL_UNIFORM_BUFFER, true);
     find_cluster_ranges(in.set->cluster_count);
     shade_program_ =
         GlProgram("decoupled shading",
@@ -333,15 +362,23 @@ class DecoupledPath : public ClusterPath {
   void shade(const Camera& camera) {
     set_camera_uniforms(shade_program_, camera);
     glEnable(GL_RASTERIZER_DISCARD);
+    // The feedback target is the buffer attribute 15 reads; a buffer both bound for feedback
+    // and enabled as a vertex source is undefined (GL 4.5 core, 13.2.2), so the attribute is
+    // off while the buffer is written.
+    mesh_->bind();
+    glDisableVertexAttribArray(kAttrRadiance);
     glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, mesh_->radiance_buffer());
     glBeginTransformFeedback(GL_POINTS);
+    begin_work("feedback", mesh_->vertex_count());
     for (std::size_t i = 0; i < ranges_.size(); ++i) {
       glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, offsets_[i],
                         cluster_bytes());
       glDrawArrays(GL_POINTS, ranges_[i].first, ranges_[i].second);
     }
+    end_work();
     glEndTransformFeedback();
     glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+    glEnableVertexAttribArray(kAttrRadiance);
     glDisable(GL_RASTERIZER_DISCARD);
   }
 
@@ -357,8 +394,8 @@ class DecoupledPath : public ClusterPath {
 // The same constants, per-vertex radiance in C++ (render/shading.h), drawn pass-through.
 class CpuPath : public ClusterPath {
  public:
-  explicit CpuPath(const PathInput& in) : ClusterPath(in, false, false, false) {
-    upload(slots(), {}, GL_UNIFORM_BUFFER, false);
+  explicit CpuPath(const PathInput& in) : ClusterPath(in, false, false, false, false, false) {
+    upload(slots(), GL_UNIFORM_BUFFER, false);
     program_ =
         GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
   }

@@ -90,6 +90,29 @@ GlInfo current_gl_info() {
   return i;
 }
 
+namespace {
+
+void GLAPIENTRY on_debug_message(GLenum, GLenum type, GLuint, GLenum, GLsizei length,
+                                 const GLchar* message, const void* user) {
+  if (type != GL_DEBUG_TYPE_ERROR && type != GL_DEBUG_TYPE_UNDEFINED_BEHAVIOR) return;
+  auto* log = static_cast<GlDebugLog*>(const_cast<void*>(user));
+  log->add(length < 0 ? std::string(message) : std::string(message, std::size_t(length)));
+}
+
+}  // namespace
+
+GlDebugLog::GlDebugLog() {
+  glEnable(GL_DEBUG_OUTPUT);
+  glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+  glDebugMessageCallback(on_debug_message, this);
+  glDebugMessageControl(GL_DONT_CARE, GL_DONT_CARE, GL_DONT_CARE, 0, nullptr, GL_TRUE);
+}
+
+GlDebugLog::~GlDebugLog() {
+  glDebugMessageCallback(nullptr, nullptr);
+  glDisable(GL_DEBUG_OUTPUT);
+}
+
 void check_gl(const char* where) {
   std::string codes;
   for (GLenum e = glGetError(); e != GL_NO_ERROR; e = glGetError()) {

@@ -2,9 +2,11 @@
 
 #include "common/check.h"
 #include "render/gl_context.h"
+#include "render/glm_eigen.h"
 #include "render/shader_source.h"
 
 #include <meshoptimizer.h>
+#include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
 #include <cstdint>
@@ -25,10 +27,10 @@ GLuint make_buffer(GLenum target, GLsizeiptr bytes, const void* data, GLenum usa
 
 void set_camera_uniforms(GlProgram& program, const Camera& camera) {
   program.use();
-  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
-  glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
-  const Eigen::Vector3f eye = camera.eye.cast<float>();
-  glUniform3fv(program.uniform("u_eye"), 1, eye.data());
+  const glm::mat4 clip(to_glm(camera.clip_from_world()));
+  glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, glm::value_ptr(clip));
+  const glm::vec3 eye(to_glm(camera.eye));
+  glUniform3fv(program.uniform("u_eye"), 1, glm::value_ptr(eye));
 }
 
 namespace {
@@ -42,8 +44,9 @@ void float_attribute(GLuint vao, GLuint location, GLuint buffer, int size) {
 
 meshes::Mesh reorder(const meshes::Mesh& source, const std::vector<std::uint32_t>& old_of_new) {
   const std::size_t V = old_of_new.size();
-  std::vector<std::uint32_t> new_of_old(V);
-  for (std::size_t i = 0; i < V; ++i) new_of_old[old_of_new[i]] = std::uint32_t(i);
+  std::vector<std::uint32_t> new_of_old(source.vertex_count());
+  for (std::size_t i = 0; i < source.vertex_count(); ++i)
+    new_of_old[old_of_new[i]] = std::uint32_t(i);
   meshes::Mesh mesh;
   mesh.positions.resize(V);
   mesh.normals.resize(V);
@@ -62,14 +65,60 @@ meshes::Mesh reorder(const meshes::Mesh& source, const std::vector<std::uint32_t
   return mesh;
 }
 
+std::vector<std::uint32_t> flatten(const meshes::Mesh& mesh, const std::vector<std::uint32_t>& ids,
+                                   bool optimize) {
+  std::vector<std::uint32_t> list;
+  list.reserve(ids.size() * 3);
+  for (std::uint32_t t : ids)
+    for (int c = 0; c < 3; ++c) list.push_back(mesh.triangles[t][c]);
+  if (optimize && !list.empty()) {
+    std::vector<std::uint32_t> optimised(list.size());
+    meshopt_optimizeVertexCache(optimised.data(), list.data(), list.size(), mesh.vertex_count());
+    list.swap(optimised);
+  }
+  return list;
+}
+
 }  // namespace
+
+std::vector<std::uint32_t> first_use_rank(const meshes::Mesh& mesh, bool optimize) {
+  std::vector<std::uint32_t> all(mesh.triangle_count());
+  std::iota(all.begin(), all.end(), 0u);
+  const std::vector<std::uint32_t> list = flatten(mesh, all, optimize);
+  constexpr std::uint32_t kUnseen = ~0u;
+  std::vector<std::uint32_t> rank(mesh.vertex_count(), kUnseen);
+  std::uint32_t next = 0;
+  for (std::uint32_t v : list)
+    if (rank[v] == kUnseen) rank[v] = next++;
+  for (std::uint32_t& r : rank)
+    if (r == kUnseen) r = next++;
+  return rank;
+}
+
+std::vector<std::uint32_t> append_vertex_block(const meshes::Mesh& source,
+                                               const std::vector<std::uint32_t>& triangle_ids,
+                                               bool optimize,
+                                               std::vector<std::uint32_t>& old_of_new) {
+  std::vector<std::uint32_t> list = flatten(source, triangle_ids, optimize);
+  constexpr std::uint32_t kUnseen = ~0u;
+  std::vector<std::uint32_t> copy_of(source.vertex_count(), kUnseen);
+  for (std::uint32_t& v : list) {
+    if (copy_of[v] == kUnseen) {
+      copy_of[v] = std::uint32_t(old_of_new.size());
+      old_of_new.push_back(v);
+    }
+    v = copy_of[v];
+  }
+  return list;
+}
 
 GpuMesh::GpuMesh(const meshes::Mesh& source, std::vector<std::uint32_t> old_of_new,
                  bool optimize_vertex_cache)
     : mesh_(reorder(source, old_of_new)),
       old_of_new_(std::move(old_of_new)),
+      source_vertices_(source.vertex_count()),
       optimize_(optimize_vertex_cache) {
-  PRTR_DCHECK(old_of_new_.size() == source.vertex_count());
+  PRTR_DCHECK(old_of_new_.size() >= source.vertex_count());
   const std::size_t V = vertex_count();
   glGenVertexArrays(1, &vao_);
   glBindVertexArray(vao_);
@@ -96,17 +145,22 @@ GpuMesh::~GpuMesh() {
 IndexRange GpuMesh::add_triangles(const std::vector<std::uint32_t>& ids) {
   IndexRange r;
   r.first = GLsizeiptr(indices_.size());
-  std::vector<std::uint32_t> list;
-  list.reserve(ids.size() * 3);
-  for (std::uint32_t t : ids)
-    for (int c = 0; c < 3; ++c) list.push_back(mesh_.triangles[t][c]);
-  if (optimize_ && !list.empty()) {
-    std::vector<std::uint32_t> optimised(list.size());
-    meshopt_optimizeVertexCache(optimised.data(), list.data(), list.size(), vertex_count());
-    list.swap(optimised);
-  }
+  std::vector<std::uint32_t> list = flatten(mesh_, ids, optimize_);
   indices_.insert(indices_.end(), list.begin(), list.end());
   r.count = GLsizei(list.size());
+  std::sort(list.begin(), list.end());
+  r.referenced = std::uint64_t(std::unique(list.begin(), list.end()) - list.begin());
+  return r;
+}
+
+IndexRange GpuMesh::add_indices(const std::vector<std::uint32_t>& list) {
+  IndexRange r;
+  r.first = GLsizeiptr(indices_.size());
+  indices_.insert(indices_.end(), list.begin(), list.end());
+  r.count = GLsizei(list.size());
+  std::vector<std::uint32_t> sorted = list;
+  std::sort(sorted.begin(), sorted.end());
+  r.referenced = std::uint64_t(std::unique(sorted.begin(), sorted.end()) - sorted.begin());
   return r;
 }
 

@@ -7,10 +7,13 @@
 
 #include "gpu_mesh.h"
 #include "render/renderer.h"
+#include "work_counter.h"
 
 #include <Eigen/Core>
 
 #include <memory>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace render {
@@ -35,7 +38,17 @@ class RenderPath {
   virtual std::size_t passes() const { return 1; }
   virtual bool pass_drew(std::size_t) const { return true; }
 
+  // Where draw() counts its work; null (the default) counts nothing.
+  void set_work_counter(WorkCounter* counter) { work_ = counter; }
+
  protected:
+  void begin_work(std::string label, std::uint64_t referenced) {
+    if (work_) work_->begin(std::move(label), referenced);
+  }
+  void end_work() {
+    if (work_) work_->end();
+  }
+
   // One draw of the whole mesh with `program` (depth test GL_LESS), counted in queries[0].
   void draw_whole(GlProgram& program, const Camera& camera, const std::vector<GLuint>& queries);
   // Every vertex through `program` once, as points, capturing its radiance.
@@ -43,6 +56,7 @@ class RenderPath {
 
   std::unique_ptr<GpuMesh> mesh_;
   IndexRange whole_;
+  WorkCounter* work_ = nullptr;
 };
 
 struct PathInput {

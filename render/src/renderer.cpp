@@ -7,6 +7,7 @@
 #include "prt/sh_rotation.h"
 #include "render/gl_context.h"
 #include "render_path.h"
+#include "work_counter.h"
 
 #include <algorithm>
 #include <chrono>
@@ -63,6 +64,7 @@ struct Renderer::Impl {
   Background background;
   FrameTarget target;
   std::vector<GLuint> queries;
+  WorkCounter work;
   prt::ShRotation rotation{1, Eigen::Matrix3d::Identity()};
   Eigen::MatrixXd lit;
 
@@ -140,9 +142,15 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
     queries.assign(path->passes(), 0);
     glGenQueries(GLsizei(queries.size()), queries.data());
   }
+  work.reset();
+  path->set_work_counter(options.count_work ? &work : nullptr);
   path->draw(camera, options.count_primitives ? queries : std::vector<GLuint>{});
   // Background where no triangle wrote depth (depth is still the cleared 1.0).
-  if (probe_background) background_pass.draw(camera, rotation_matrix);
+  if (probe_background) {
+    if (options.count_work) work.begin("background", 3);
+    background_pass.draw(camera, rotation_matrix);
+    if (options.count_work) work.end();
+  }
   glDepthMask(GL_TRUE);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   path->mesh().bind();
@@ -168,6 +176,10 @@ void Renderer::set_background(const Background& background) {
   impl_->background = background;
 }
 
+void Renderer::set_count_work(bool on) {
+  impl_->options.count_work = on;
+}
+
 FrameTiming Renderer::render(const Camera& camera,
                              const Eigen::Ref<const prt::ShLighting>& lighting,
                              const Eigen::Matrix3d& rotation) {
@@ -182,6 +194,7 @@ FrameTiming Renderer::render(const Camera& camera,
   timing.gl_ms = ms_since(gl_start);
   timing.total_ms = ms_since(start);
   if (impl_->options.count_primitives) impl_->read_queries();
+  if (impl_->options.count_work) impl_->stats.pass_work = impl_->work.read();
   check_gl("Renderer::render");
   return timing;
 }
@@ -200,7 +213,8 @@ std::vector<Rgb> Renderer::capture_vertex_radiance(
   mesh.bind();
   const std::vector<Rgb> gpu = impl_->path->capture(camera);
   check_gl("Renderer::capture_vertex_radiance");
-  std::vector<Rgb> out(gpu.size());
+  // Copies of a vertex (per-pass blocks) capture the same radiance; any one will do.
+  std::vector<Rgb> out(mesh.source_vertex_count());
   for (std::size_t i = 0; i < gpu.size(); ++i) out[mesh.old_of_new()[i]] = gpu[i];
   return out;
 }

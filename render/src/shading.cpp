@@ -107,7 +107,12 @@ void shade_vertices(const cpca::CompressedSet& set, const ConstantLayout& layout
         Eigen::VectorXf y(layout.rows);
         Eigen::VectorXf s(layout.terms * 3);
         for (std::size_t p = range.begin(); p < range.end(); ++p) {
-          basis_at(layout.order, layout.glossy, local_view(mesh, p, eye), y.data());
+          const Eigen::Vector3d local = local_view(mesh, p, eye);
+          if (layout.glossy && local.z() <= 0.0) {
+            radiance[p] = Rgb::Zero();  // below the local horizon (render/shading.h)
+            continue;
+          }
+          basis_at(layout.order, layout.glossy, local, y.data());
           const float* k = constants + std::size_t(set.cluster_of[p]) * layout.floats_stride();
           // (terms * 3) x rows, row-major: one row per (term, colour).
           s.noalias() = Eigen::Map<const RowMatrixXf>(k, layout.terms * 3, layout.rows) * y;
@@ -133,8 +138,13 @@ std::vector<Rgb> reference_vertex_radiance(const cpca::CompressedSet& set, const
   std::vector<double> y(std::size_t(std::max(rows, 1)));
   for (std::size_t p = 0; p < mesh.vertex_count(); ++p) {
     cpca::reconstruct_vertex(set, p, x.data());
+    const Eigen::Vector3d local = local_view(mesh, p, eye);
+    if (glossy && local.z() <= 0.0) {
+      out[p] = Rgb::Zero();
+      continue;
+    }
     if (glossy)
-      prt::sh_eval(set.order, local_view(mesh, p, eye), y.data());
+      prt::sh_eval(set.order, local, y.data());
     else
       y[0] = 1.0;
     for (int c = 0; c < 3; ++c) {
@@ -194,7 +204,12 @@ void shade_exit_vectors(const std::vector<float>& exit, int order, bool glossy,
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       Eigen::VectorXf y(rows);
                       for (std::size_t p = range.begin(); p < range.end(); ++p) {
-                        basis_at(order, glossy, local_view(mesh, p, eye), y.data());
+                        const Eigen::Vector3d local = local_view(mesh, p, eye);
+                        if (glossy && local.z() <= 0.0) {
+                          radiance[p] = Rgb::Zero();
+                          continue;
+                        }
+                        basis_at(order, glossy, local, y.data());
                         radiance[p] =
                             Eigen::Map<const RowMatrixXf>(exit.data() + p * 3 * rows, 3, rows) * y;
                       }

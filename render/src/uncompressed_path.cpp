@@ -14,10 +14,11 @@ namespace {
 class UncompressedPath : public RenderPath {
  public:
   explicit UncompressedPath(const PathInput& in) : transfer_(*in.transfer) {
-    std::vector<std::uint32_t> identity(in.mesh.vertex_count());
-    std::iota(identity.begin(), identity.end(), 0u);
-    mesh_ =
-        std::make_unique<GpuMesh>(in.mesh, std::move(identity), in.options.optimize_vertex_cache);
+    // Mesh order: the exit vectors are indexed by gl_VertexID in source order, and
+    // renumbering would cost a per-frame permutation of the whole buffer.
+    std::vector<std::uint32_t> vertices(in.mesh.vertex_count());
+    std::iota(vertices.begin(), vertices.end(), 0u);
+    mesh_ = std::make_unique<GpuMesh>(in.mesh, std::move(vertices), in.options.optimize_vertex_cache);
     whole_ = mesh_->add_all_triangles();
     mesh_->upload_indices();
     const int order = transfer_.order;
@@ -62,7 +63,9 @@ void RenderPath::draw_whole(GlProgram& program, const Camera& camera,
   set_camera_uniforms(program, camera);
   glDepthFunc(GL_LESS);
   if (!queries.empty()) glBeginQuery(GL_PRIMITIVES_GENERATED, queries[0]);
+  begin_work("shade", whole_.referenced);
   mesh_->draw(whole_);
+  end_work();
   if (!queries.empty()) glEndQuery(GL_PRIMITIVES_GENERATED);
 }
 

@@ -6,7 +6,11 @@
 #pragma once
 
 #include "meshes/mesh.h"
+#include "probes/probe.h"
 #include "render/camera.h"
+#include "render/renderer.h"
+
+#include <vector>
 
 namespace render {
 
@@ -14,6 +18,11 @@ struct FloorOptions {
   bool cull_back_faces = true;
   bool optimize_vertex_cache = true;
   int frames = 20, warmup = 3;
+  // The renderer's probe background pass after the mesh, so the floor has the same passes
+  // over the framebuffer as a real frame (like-for-like ratios); null = mesh only.
+  const probes::Probe* background = nullptr;
+  // When set, the pipeline statistics of the last frame's draws (RenderStats::pass_work).
+  std::vector<PassWork>* work = nullptr;
 };
 
 // Median milliseconds of one clear + draw + glFinish. Needs a current GL context.

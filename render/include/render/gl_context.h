@@ -5,6 +5,8 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace render {
 
@@ -50,6 +52,22 @@ class GlContext {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+// While alive, collects the current context's KHR_debug messages of type error or undefined
+// behaviour (synchronous output, so each message follows the call that caused it). Tests
+// hold the renderer to an empty log: llvmpipe tolerates hazards a stricter driver rejects.
+class GlDebugLog {
+ public:
+  GlDebugLog();
+  ~GlDebugLog();
+  GlDebugLog(const GlDebugLog&) = delete;
+  GlDebugLog& operator=(const GlDebugLog&) = delete;
+  const std::vector<std::string>& messages() const { return messages_; }
+  void add(std::string message) { messages_.push_back(std::move(message)); }
+
+ private:
+  std::vector<std::string> messages_;
 };
 
 // Throws GlError naming `where` and the GL error code(s) when glGetError reports any.

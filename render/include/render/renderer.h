@@ -63,7 +63,13 @@ struct RendererOptions {
   std::optional<cpca::SuperClusters> groups;
   bool cull_back_faces = true;        // halves raster cost; closed meshes only
   bool optimize_vertex_cache = true;  // meshoptimizer order per index buffer
-  bool count_primitives = false;      // GL_PRIMITIVES_GENERATED query per pass (slower)
+  // Vertices numbered in each draw's first-use order (multipass: a block of copies per pass)
+  // so llvmpipe shades each about once per draw; false keeps the earlier numbering (slot
+  // order) to measure the difference.
+  bool renumber_vertices = true;
+  bool count_primitives = false;  // GL_PRIMITIVES_GENERATED query per pass (slower)
+  // Pipeline-statistics queries around every draw of a frame (RenderStats::pass_work).
+  bool count_work = false;
 };
 
 struct Background {
@@ -77,6 +83,21 @@ struct FrameTiming {
   double total_ms = 0;  // the frame
 };
 
+// One draw of a frame counted by GL_ARB_pipeline_statistics_query. `referenced_vertices` is
+// the distinct vertices the draw can reach, so vs_invocations / referenced_vertices is the
+// vertex-shader work wasted by the driver's post-transform reuse (1 is ideal).
+struct PassWork {
+  std::string label;  // "depth", "shade 12", "feedback", "background", ...
+  std::uint64_t vs_invocations = 0, primitives = 0, fs_invocations = 0;
+  std::uint64_t referenced_vertices = 0;
+};
+struct WorkTotals {
+  std::uint64_t vs_invocations = 0, primitives = 0, fs_invocations = 0;
+  std::uint64_t referenced_vertices = 0;
+  double vs_per_referenced_vertex = 0;
+};
+WorkTotals work_totals(const std::vector<PassWork>& passes);
+
 struct RenderStats {
   int register_budget = 0;
   int registers_per_cluster = 0;
@@ -84,6 +105,7 @@ struct RenderStats {
   int passes = 1;                                 // shading passes (draws over triangles)
   std::vector<std::uint64_t> triangles_per_pass;  // predicted from cluster ids and grouping
   std::vector<std::uint64_t> measured_triangles;  // GL queries of the last frame (if enabled)
+  std::vector<PassWork> pass_work;                // the last frame's, with count_work
   double average_overdraw = 1.0;
   std::uint64_t triangle_count = 0;
   std::uint64_t vertex_count = 0;
@@ -103,6 +125,9 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   void set_background(const Background& background);
+  // RendererOptions::count_work for the following frames (timing frames leave it off so the
+  // queries cost nothing there).
+  void set_count_work(bool on);
 
   // Draws one frame (waits for it with glFinish) and returns its timing.
   FrameTiming render(const Camera& camera, const Eigen::Ref<const prt::ShLighting>& lighting,

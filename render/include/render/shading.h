@@ -8,6 +8,9 @@
 // and a vertex p of cluster k with weights w_pj has the exit-radiance SH vector
 //     e_p = a_k + sum_j w_pj b_kj,   radiance toward world v = y(F_p^T v) . e_p[:, c]
 // (glossy), or e_p itself (diffuse, view independent; there y is the constant 1).
+// Glossy radiance is zero where the view is at or below the local horizon (F_p^T v).z <= 0:
+// nothing leaves a surface backwards, and there the order-n truncation of the lobe rings
+// negative (every path and every reference here applies the same cut).
 //
 // Constant layout, shared with the GLSL generator (render/shader_source.h) and matching
 // cpca::registers_per_cluster: per cluster, terms t = 0 (the mean) .. N, then colour c,
