@@ -39,10 +39,13 @@ if ((${#missing[@]})); then
   export DEBIAN_FRONTEND=noninteractive
   "${sudo_cmd[@]}" apt-get update -qq
   "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  echo "setup: installed ${#missing[@]} packages in $SECONDS s" >&2
 else
   echo "setup: all ${#packages[@]} packages present" >&2
 fi
 
 build_type=${PRTR_BUILD_TYPE:-Release}
+build_start=$SECONDS
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
 cmake --build build -j "$(nproc)"
+echo "setup: configured and built ./build ($build_type) in $((SECONDS - build_start)) s" >&2
