@@ -3,6 +3,8 @@
 // from a point just outside the surface), plus the nearly-occluded vertex diagnostic.
 #include "prt/bake.h"
 
+#include "ray_oracle.h"
+
 #include "meshes/frames.h"
 #include "meshes/load.h"
 #include "meshes/procedural.h"
@@ -38,21 +40,8 @@ double white_sky(const prt::TransferSet& t, std::size_t p) {
 
 // First hit along o + t d, t > 0, against every triangle; true when anything is hit.
 bool brute_hits(const meshes::Mesh& m, const Vec3d& o, const Vec3d& d) {
-  for (const meshes::Triangle& tri : m.triangles) {
-    const Vec3d p0 = m.positions[tri[0]].cast<double>();
-    const Vec3d e1 = m.positions[tri[1]].cast<double>() - p0;
-    const Vec3d e2 = m.positions[tri[2]].cast<double>() - p0;
-    const Vec3d pv = d.cross(e2);
-    const double det = e1.dot(pv);
-    if (std::abs(det) < 1e-14) continue;
-    const Vec3d tv = o - p0;
-    const double u = tv.dot(pv) / det;
-    if (u < 0 || u > 1) continue;
-    const Vec3d qv = tv.cross(e1);
-    const double v = d.dot(qv) / det;
-    if (v < 0 || u + v > 1) continue;
-    if (e2.dot(qv) / det > 1e-12) return true;
-  }
+  for (std::size_t t = 0; t < m.triangles.size(); ++t)
+    if (test_support::ray_hits_triangle(m, t, o, d, 1e-12)) return true;
   return false;
 }
 

@@ -3,6 +3,8 @@
 // analytic box), its own Monte Carlo sampling, and no projection of visibility to SH.
 #include "prt/bake.h"
 
+#include "ray_oracle.h"
+
 #include "meshes/procedural.h"
 #include "prt/sampling.h"
 #include "prt/sh.h"
@@ -77,21 +79,8 @@ bool ray_hits(const meshes::Mesh& m, std::size_t first_tri, std::size_t last_tri
   const Vec3d oc = o - centre;
   const double b = oc.dot(d), c = oc.squaredNorm() - radius * radius;
   if (c > 0 && (b > 0 || b * b < c)) return false;
-  for (std::size_t t = first_tri; t < last_tri; ++t) {
-    const Vec3d p0 = m.positions[m.triangles[t][0]].cast<double>();
-    const Vec3d e1 = m.positions[m.triangles[t][1]].cast<double>() - p0;
-    const Vec3d e2 = m.positions[m.triangles[t][2]].cast<double>() - p0;
-    const Vec3d pv = d.cross(e2);
-    const double det = e1.dot(pv);
-    if (std::abs(det) < 1e-14) continue;
-    const Vec3d tv = o - p0;
-    const double u = tv.dot(pv) / det;
-    if (u < 0 || u > 1) continue;
-    const Vec3d qv = tv.cross(e1);
-    const double v = d.dot(qv) / det;
-    if (v < 0 || u + v > 1) continue;
-    if (e2.dot(qv) / det > 1e-9) return true;
-  }
+  for (std::size_t t = first_tri; t < last_tri; ++t)
+    if (test_support::ray_hits_triangle(m, t, o, d, 1e-9)) return true;
   return false;
 }
 

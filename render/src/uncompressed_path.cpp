@@ -18,7 +18,8 @@ class UncompressedPath : public RenderPath {
     // renumbering would cost a per-frame permutation of the whole buffer.
     std::vector<std::uint32_t> vertices(in.mesh.vertex_count());
     std::iota(vertices.begin(), vertices.end(), 0u);
-    mesh_ = std::make_unique<GpuMesh>(in.mesh, std::move(vertices), in.options.optimize_vertex_cache);
+    mesh_ =
+        std::make_unique<GpuMesh>(in.mesh, std::move(vertices), in.options.optimize_vertex_cache);
     whole_ = mesh_->add_all_triangles();
     mesh_->upload_indices();
     const int order = transfer_.order;
