@@ -25,12 +25,17 @@ namespace {
 using Vec3d = Eigen::Vector3d;
 constexpr double kPi = std::numbers::pi;
 
-prt::Material white_lambert() {
-  prt::Material m;
-  m.kind = prt::MaterialKind::kLambert;
-  m.albedo = Eigen::Vector3f::Constant(1.f);
-  m.specular = 0.f;
-  return m;
+// A diffuse bake of a white Lambert surface: under a white sky its DC term is the visibility.
+prt::BakeOptions white_lambert_bake(int order, int samples, int bounces) {
+  prt::BakeOptions o;
+  o.kind = prt::TransferKind::kDiffuse;
+  o.material.kind = prt::MaterialKind::kLambert;
+  o.material.albedo = Eigen::Vector3f::Constant(1.f);
+  o.material.specular = 0.f;
+  o.order = order;
+  o.samples = samples;
+  o.bounces = bounces;
+  return o;
 }
 
 // Diffuse exit radiance under a white sky of radiance 1, i.e. (rho / pi) int V cos.
@@ -113,12 +118,7 @@ TEST(BakeOrigin, GroovePitSeesDownTheGroove) {
   const Vec3d n = m.normals[pit].cast<double>();
   ASSERT_NEAR(n.y(), 1.0, 1e-5);  // the premise: the vertex normal points up the groove
 
-  prt::BakeOptions o;
-  o.kind = prt::TransferKind::kDiffuse;
-  o.material = white_lambert();
-  o.order = 2;
-  o.samples = 4096;
-  o.bounces = 0;
+  prt::BakeOptions o = white_lambert_bake(2, 4096, 0);
   prt::BakeStats stats;
   const prt::TransferSet t = prt::bake(m, o, &stats);
 
@@ -138,13 +138,8 @@ TEST(BakeOrigin, GroovePitBounceSeesTheWalls) {
   // from them, and no more than the energy bound allows.
   std::uint32_t pit = 0;
   const meshes::Mesh m = grooved_prism(&pit);
-  prt::BakeOptions o;
-  o.kind = prt::TransferKind::kDiffuse;
-  o.material = white_lambert();
+  prt::BakeOptions o = white_lambert_bake(2, 1024, 1);
   o.material.albedo = Eigen::Vector3f::Constant(0.5f);
-  o.order = 2;
-  o.samples = 1024;
-  o.bounces = 1;
   const prt::TransferSet t = prt::bake(m, o);
   o.bounces = 0;
   const prt::TransferSet direct = prt::bake(m, o);
@@ -166,12 +161,7 @@ TEST(BakeOrigin, ReportsEnclosedVertices) {
   for (meshes::Vec3& p : lid.positions) p = meshes::Vec3(p.x(), 0.6f - p.y(), -p.z());
   const meshes::Mesh plane = meshes::make_plane(4.f, 16);
   const meshes::Mesh m = meshes::merge({plane, lid});
-  prt::BakeOptions o;
-  o.kind = prt::TransferKind::kDiffuse;
-  o.material = white_lambert();
-  o.order = 2;
-  o.samples = 256;
-  o.bounces = 0;
+  prt::BakeOptions o = white_lambert_bake(2, 256, 0);
   prt::BakeStats stats;
   prt::bake(m, o, &stats);
   std::vector<std::uint32_t> expected;
@@ -198,12 +188,7 @@ TEST(BakeOrigin, BunnyPitsSeeTheSkyAndBlackVerticesAreReported) {
   const std::filesystem::path bunny = "/usr/share/glmark2/models/bunny.obj";
   if (!std::filesystem::exists(bunny)) GTEST_SKIP() << bunny << " missing (glmark2-data)";
   const meshes::Mesh m = meshes::load_mesh(bunny);
-  prt::BakeOptions o;
-  o.kind = prt::TransferKind::kDiffuse;
-  o.material = white_lambert();
-  o.order = 1;
-  o.samples = 256;
-  o.bounces = 0;
+  prt::BakeOptions o = white_lambert_bake(1, 256, 0);
   prt::BakeStats stats;
   const prt::TransferSet t = prt::bake(m, o, &stats);
   // Two pits under the bunny whose summed face normals point into the body: a brute-force
@@ -305,12 +290,7 @@ TEST(BakeOrigin, VertexFoldedJustInsideSeesFromOutsideItsFace) {
   // The premise: from the vertex, nothing escapes, so an origin near it bakes black.
   EXPECT_EQ(brute_visibility(m, p + 1e-6 * n, n, 2000, 3), 0.0);
 
-  prt::BakeOptions o;
-  o.kind = prt::TransferKind::kDiffuse;
-  o.material = white_lambert();
-  o.order = 2;
-  o.samples = 4096;
-  o.bounces = 0;
+  prt::BakeOptions o = white_lambert_bake(2, 4096, 0);
   prt::BakeStats stats;
   const prt::TransferSet t = prt::bake(m, o, &stats);
   EXPECT_EQ(stats.moved_origins, std::vector<std::uint32_t>{v});
@@ -346,12 +326,7 @@ TEST(BakeOrigin, BoxInsideABoxStaysBlackAndReported) {
   const meshes::Mesh outer = closed_box({-2.f, -2.f, -2.f}, {2.f, 2.f, 2.f});
   const meshes::Mesh inner = closed_box({-0.5f, -0.5f, -0.5f}, {0.5f, 1.98f, 0.5f});
   const meshes::Mesh m = meshes::merge({outer, inner});
-  prt::BakeOptions o;
-  o.kind = prt::TransferKind::kDiffuse;
-  o.material = white_lambert();
-  o.order = 2;
-  o.samples = 1024;
-  o.bounces = 0;
+  prt::BakeOptions o = white_lambert_bake(2, 1024, 0);
   prt::BakeStats stats;
   const prt::TransferSet t = prt::bake(m, o, &stats);
   std::vector<std::uint32_t> expected;
