@@ -1,6 +1,6 @@
 // fuzz/fuzz_support.h: what every libFuzzer target here shares. The loaders under test take
 // paths, so each input is written to a file first; the file lives in memory (/dev/shm) where
-// there is one, so that the write costs microseconds.
+// that works, so that the write costs microseconds, and in $TMPDIR or /tmp otherwise.
 #pragma once
 
 #include "common/hash.h"
@@ -9,23 +9,35 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 namespace fuzz_support {
 
 // A path ending in `extension` that belongs to this process alone (libFuzzer's -fork and
-// -jobs modes run several processes side by side).
+// -jobs modes run several processes side by side). /dev/shm first; where it is missing, full,
+// read-only or not ours to write (a container without a tmpfs there), $TMPDIR, then /tmp.
 inline const std::filesystem::path& scratch_path(const std::string& extension) {
   static const std::filesystem::path path = [&] {
-    const std::filesystem::path base = std::filesystem::is_directory("/dev/shm")
-                                           ? "/dev/shm"
-                                           : std::filesystem::temp_directory_path();
-    const std::filesystem::path dir = base / ("prtr-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return dir / ("input" + extension);
+    namespace fs = std::filesystem;
+    std::vector<fs::path> bases{"/dev/shm"};
+    if (const char* tmpdir = std::getenv("TMPDIR"); tmpdir && *tmpdir) bases.emplace_back(tmpdir);
+    bases.emplace_back("/tmp");
+    const std::string name = "prtr-fuzz-" + std::to_string(::getpid());
+    for (const fs::path& base : bases) {
+      std::error_code ec;
+      const fs::path dir = base / name;
+      fs::create_directories(dir, ec);
+      const fs::path file = dir / ("input" + extension);
+      if (!ec && std::ofstream(file, std::ios::binary | std::ios::trunc).put('x')) return file;
+    }
+    std::fprintf(stderr, "fuzz: cannot write a scratch file in /dev/shm, $TMPDIR or /tmp\n");
+    std::abort();
   }();
   return path;
 }

@@ -7,10 +7,12 @@
 //
 // Usage: make_seeds OUTPUT_DIR BUNNY_OBJ MODELS_DIR PROBES_DIR
 #include "meshes/load.h"
+#include "probes/cube_map.h"
 #include "probes/load.h"
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -192,6 +194,23 @@ void probe_seeds(const fs::path& out, const fs::path& source, int width) {
     if (!file || !file->open(path.string(), spec) ||
         !file->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) || !file->close()) {
       throw std::runtime_error("cannot write " + path.string());
+    }
+  }
+  // Cube crosses of the same probe (faces width / 4), so the cube-map reader is reached too.
+  const probes::CubeMap cube = probes::latlong_to_cube(p, std::max(width / 4, 1));
+  for (const auto kind : {probes::CrossKind::kHorizontal, probes::CrossKind::kVertical}) {
+    int w = 0, h = 0;
+    const std::vector<probes::Rgb> cross = probes::cube_to_cross(cube, kind, &w, &h);
+    const char* tag = kind == probes::CrossKind::kHorizontal ? "_hcross" : "_vcross";
+    for (const char* dir : {"probe_exr", "probe_hdr"}) {
+      const bool exr = std::string(dir) == "probe_exr";
+      const fs::path path = out / dir / (stem + tag + (exr ? ".exr" : ".hdr"));
+      auto file = OIIO::ImageOutput::create(path.string());
+      OIIO::ImageSpec spec(w, h, 3, exr ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+      if (!file || !file->open(path.string(), spec) ||
+          !file->write_image(OIIO::TypeDesc::FLOAT, cross.data()) || !file->close()) {
+        throw std::runtime_error("cannot write " + path.string());
+      }
     }
   }
 }

@@ -84,6 +84,15 @@ add negative.exr probe "EXR attribute with a negative size"
 { printf '\x76\x2f\x31\x01'; le V 2; printf 'channels\0chlist\0'; le V 1; printf 'R\0'; head -c 17 /dev/zero
   printf 'x\0string\0'; le V 1900000000; head -c 100 /dev/zero | tr '\0' x; } >desync.exr
 add desync.exr probe "EXR channel list declaring 1 byte for 19, then an attribute claiming 1.9 GB"
+# Found by fuzz_probe_exr: a data window 16.5 M texels wide, whose 16-line ZIP blocks OpenEXR
+# sized (1.5 GB) while opening the file.
+perl -e 'my $ch = join("", map { "$_\0" . pack("lCx3ll", 1, 0, 1, 1) } qw(B G R)) . "\0";
+  my $win = pack("l4", 0, 0, 16514823, 3);
+  sub attr { my ($n, $t, $v) = @_; "$n\0$t\0" . pack("l", length $v) . $v }
+  print "\x76\x2f\x31\x01", pack("V", 2), attr("channels", "chlist", $ch),
+    attr("compression", "compression", "\x03"), attr("dataWindow", "box2i", $win),
+    attr("displayWindow", "box2i", $win), attr("lineOrder", "lineOrder", "\0"), "\0", "\0" x 1800' >wide.exr
+add wide.exr probe "2 KB EXR whose data window is 16.5 M texels wide (ZIP blocks of 1.5 GB)"
 echo "not an image" >garbage.exr
 add garbage.exr probe "text that is not an image"
 if [[ -f $probe ]]; then
@@ -124,7 +133,9 @@ measure=()
   echo "Size limits behind these answers: mesh readers check every count a header claims"
   echo "against the bytes left in the file before allocating; probe loading refuses an image"
   echo "whose decoded size exceeds 4096 times the file size (above 64 MiB) or the free memory,"
-  echo "and any EXR header attribute larger than the file."
+  echo "any EXR header attribute larger than the file, and any EXR header whose data window"
+  echo "sizes OpenEXR's buffers (one block of scan lines or one tile past the same limit, an"
+  echo "offset table longer than the file) before OpenEXR reads it (\`probes/src/exr_guard.cpp\`)."
   echo
   echo "Which reader does what: OFF, PLY and 3DS are read by our own strict readers"
   echo "(\`meshes/src/read_strict.cpp\`, \`meshes/src/read_3ds.cpp\`; OpenMesh's OFF and PLY readers"

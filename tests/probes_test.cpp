@@ -632,8 +632,11 @@ TEST(LoadErrors, MissingFile) {
   expect_error(tmp_dir() / "no_such_probe.exr", {}, {"no such file"});
 }
 
-TEST(LoadErrors, Directory) {
-  expect_error(tmp_dir(), {}, {"directory"});
+TEST(LoadErrors, FolderWithoutCubeFaces) {
+  // A folder is read as a six-face cube map (probes/load.h); without the faces it is named.
+  const fs::path dir = tmp_dir() / "no_faces";
+  fs::create_directories(dir);
+  expect_error(dir, {}, {"folder", "px"});
 }
 
 TEST(LoadErrors, GarbageBytes) {
@@ -659,7 +662,7 @@ TEST(LoadErrors, TruncatedExr) {
 TEST(LoadErrors, WrongAspect) {
   const fs::path path = tmp_dir() / "three_to_one.exr";
   write_image(path, 30, 10, 3, std::vector<float>(30 * 10 * 3, 1.0f));
-  expect_error(path, {}, {"30x10", "neither a 2:1 lat-long map nor a square angular map"});
+  expect_error(path, {}, {"30x10", "neither a 2:1 lat-long map, a square angular map nor a 4:3"});
 }
 
 TEST(LoadErrors, ForcedLayoutDisagrees) {

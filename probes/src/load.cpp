@@ -5,6 +5,8 @@
 // and his Light Probe Image Gallery; the orientation used here is the one in probes/load.h.
 #include "probes/load.h"
 
+#include "exr_guard.h"
+
 #include <OpenImageIO/imageio.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -12,6 +14,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -22,6 +25,7 @@
 #include <new>
 #include <numbers>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 #include <unordered_map>
 #include <utility>
@@ -54,112 +58,11 @@ std::string gigabytes(double bytes) {
   return buf;
 }
 
-// The number of bytes OpenEXR reads for an attribute value of `type` starting at `at`, which
-// for most types is fixed by the type and not by the size the file declares; -1 for types
-// whose value is as long as the declared size (strings, vectors, unknown types), -2 when a
-// value does not end within `limit`.
-std::int64_t exr_value_bytes(const std::string& type, const std::vector<char>& bytes,
-                             std::size_t at, std::size_t limit) {
-  static const std::unordered_map<std::string, std::int64_t> kFixed = {
-      {"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
-      {"compression", 1}, {"double", 8},   {"envmap", 1},
-      {"float", 4},       {"int", 4},      {"keycode", 28},
-      {"lineOrder", 1},   {"m33f", 36},    {"m33d", 72},
-      {"m44f", 64},       {"m44d", 128},   {"rational", 8},
-      {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
-      {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
-      {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
-  if (const auto it = kFixed.find(type); it != kFixed.end()) return it->second;
-  if (type == "chlist") {
-    // Channel records (name\0, then 16 bytes) up to an empty name.
-    std::size_t pos = at;
-    while (pos < limit && bytes[pos] != 0) {
-      while (pos < limit && bytes[pos] != 0) ++pos;
-      pos += 1 + 16;
-    }
-    return pos < limit ? std::int64_t(pos + 1 - at) : -2;
-  }
-  if (type == "preview") {
-    // Width and height, then 4 bytes per pixel: the size of the buffer OpenEXR allocates.
-    if (at + 8 > limit) return -2;
-    std::uint32_t wh[2];
-    std::memcpy(wh, bytes.data() + at, 8);
-    return std::int64_t(8 + 4 * std::uint64_t(wh[0]) * wh[1]);
-  }
-  return -1;
-}
-
-// Walks the attribute list of an OpenEXR header (name\0 type\0 int32 size, value) and
-// returns the first attribute whose size is negative, runs past the end of the file, or
-// differs from what OpenEXR will read for its type (OpenEXR then reads the rest of the header
-// from a different place than the sizes say, so a check by sizes alone would be blind); empty
-// when every attribute is consistent. Multi-part files hold several headers, ended by an
-// empty one.
-std::string check_exr_header(const std::filesystem::path& path, std::uintmax_t file_size) {
-  std::ifstream in(path, std::ios::binary);
-  // Headers are small; what matters is that no attribute claims more than the file holds.
-  constexpr std::size_t kHeaderWindow = 1 << 20;
-  std::vector<char> bytes(std::min<std::uintmax_t>(file_size, kHeaderWindow));
-  in.read(bytes.data(), std::streamsize(bytes.size()));
-  bytes.resize(std::size_t(in.gcount()));
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), "\x76\x2f\x31\x01", 4) != 0) return {};
-  std::uint32_t version = 0;
-  std::memcpy(&version, bytes.data() + 4, 4);
-  const bool multipart = (version & 0x1000u) != 0;
-  std::size_t at = 8;
-  // A null-terminated name of at most 255 characters at `at`, or empty when there is none.
-  const auto name_at = [&](std::size_t& pos, std::string& name) {
-    const std::size_t limit = std::min(bytes.size(), pos + 256);
-    for (std::size_t i = pos; i < limit; ++i) {
-      if (bytes[i] == 0) {
-        name.assign(bytes.data() + pos, i - pos);
-        pos = i + 1;
-        return true;
-      }
-    }
-    return false;
-  };
-  for (int header = 0; header < 1024; ++header) {
-    bool any = false;
-    while (true) {
-      std::string name, type;
-      if (!name_at(at, name)) return {};  // past what we read: OpenEXR reports it
-      if (name.empty()) break;
-      any = true;
-      if (!name_at(at, type) || at + 4 > bytes.size()) return {};
-      std::int32_t size = 0;
-      std::memcpy(&size, bytes.data() + at, 4);
-      at += 4;
-      if (size < 0 || std::uintmax_t(size) > file_size - std::min<std::uintmax_t>(at, file_size)) {
-        return "its OpenEXR header attribute '" + name + "' (" + type + ") claims " +
-               std::to_string(size) + " bytes, but the file has only " + std::to_string(file_size) +
-               " bytes in all; the file is damaged or truncated, re-export it";
-      }
-      if (std::size_t(size) > bytes.size() - at) return {};
-      const std::int64_t takes = exr_value_bytes(type, bytes, at, bytes.size());
-      if (takes != -1 && takes != size) {
-        return "its OpenEXR header attribute '" + name + "' (" + type + ") declares " +
-               std::to_string(size) + " bytes, but its value " +
-               (takes == -2 ? std::string("does not end within the file")
-                            : "takes " + std::to_string(takes)) +
-               "; the file is damaged, re-export it";
-      }
-      at += std::size_t(size);
-    }
-    if (!multipart || !any) break;
-  }
-  return {};
-}
-
 // Bytes this loader allocates per texel: the float read buffer (up to three channels) and
 // the Rgb array.
 constexpr double kBytesPerTexel = 3 * sizeof(float) + sizeof(Rgb);
-// The most texel bytes one byte of file can decode to. zlib (OpenEXR's ZIP, PXR24) peaks near
-// 1032:1 on half-float data, which doubles as float, and our Rgb copy doubles it again; the
-// factor covers that with room. A header claiming more than this is lying about its size.
-constexpr double kMaxExpansion = 4096;
-// Small images are never refused for their file size: tiny constant maps compress well.
-constexpr double kAlwaysAllowedBytes = 64.0 * 1024 * 1024;
+using detail::kAlwaysAllowedBytes;
+using detail::kMaxExpansion;
 
 double available_memory() {
   const long pages = ::sysconf(_SC_AVPHYS_PAGES);
@@ -237,47 +140,36 @@ std::vector<Rgb> angular_to_latlong(const std::vector<Rgb>& angular, int n) {
   return out;
 }
 
-}  // namespace
+// --- One image file -------------------------------------------------------------------------
 
-const char* layout_name(Layout layout) {
-  switch (layout) {
-    case Layout::kAuto:
-      return "auto";
-    case Layout::kLatLong:
-      return "lat-long";
-    case Layout::kAngular:
-      return "angular";
-  }
-  return "unknown";
-}
+struct Image {
+  std::vector<Rgb> rgb;
+  int width = 0, height = 0, channels = 0;
+  std::string format;
+  std::size_t negative = 0;
+};
 
-Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
-                 LoadReport* report) {
-  // Checked here because OpenImageIO's messages for these cases are misleading (a directory
-  // gets "could not find a format reader").
+// Checks that OpenImageIO's messages would get wrong (a directory gets "could not find a
+// format reader"), then the OpenEXR header guard; returns the file's size.
+std::uintmax_t check_file(const std::filesystem::path& path) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (status.type() == std::filesystem::file_type::not_found) fail(path, "no such file");
   if (ec) fail(path, "cannot be accessed: " + ec.message());
   if (std::filesystem::is_directory(status)) fail(path, "is a directory, not an image file");
-
   const std::uintmax_t file_size = std::filesystem::file_size(path, ec);
   if (ec) fail(path, "cannot read its size: " + ec.message());
-  if (const std::string problem = check_exr_header(path, file_size); !problem.empty()) {
+  if (const std::string problem = detail::check_exr_header(path, file_size); !problem.empty()) {
     fail(path, problem);
   }
+  return file_size;
+}
 
-  std::unique_ptr<OIIO::ImageInput> in;
-  try {
-    in = OIIO::ImageInput::open(path.string());
-  } catch (const std::bad_alloc&) {
-    fail(path, "its header asks for more memory than there is; the file is damaged, re-export it");
-  }
-  if (!in) fail(path, "cannot be read as an image: " + OIIO::geterror());
-  const OIIO::ImageSpec spec = in->spec();
+// The spec checks made before anything is sized from the header.
+void check_spec(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
+                std::uintmax_t file_size) {
   const int w = spec.width, h = spec.height, channels = spec.nchannels;
   const std::string size = std::to_string(w) + "x" + std::to_string(h);
-
   if (w <= 0 || h <= 0) fail(path, "empty image (" + size + ")");
   if (spec.depth > 1 || spec.deep) fail(path, "volume and deep images are not environment maps");
   // An EXR may store only part of its display window; the mapping needs the whole sphere.
@@ -294,26 +186,6 @@ Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
                    " channels; need 3 or more (RGB, extra channels such as alpha are "
                    "ignored) or 1 (grey)");
   }
-
-  Layout layout = options.layout;
-  const bool latlong_shape = w == 2 * h, square = w == h;
-  if (layout == Layout::kAuto) {
-    if (latlong_shape) {
-      layout = Layout::kLatLong;
-    } else if (square) {
-      layout = Layout::kAngular;
-    } else {
-      fail(path, size +
-                     " is neither a 2:1 lat-long map nor a square angular map; crop or "
-                     "resample it to one of those");
-    }
-  } else if (layout == Layout::kLatLong && !latlong_shape) {
-    fail(path, size + " is not 2:1, but the layout was forced to lat-long");
-  } else if (layout == Layout::kAngular && !square) {
-    fail(path, size + " is not square, but the layout was forced to angular");
-  }
-
-  // Checked before anything is sized from the header.
   const double needed = double(w) * double(h) * kBytesPerTexel;
   if (needed > kAlwaysAllowedBytes && needed > double(file_size) * kMaxExpansion) {
     fail(path, "its header claims " + size + " texels, which would take " + gigabytes(needed) +
@@ -324,30 +196,16 @@ Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
     fail(path, size + " texels need " + gigabytes(needed) + " to load but only " +
                    gigabytes(available) + " of memory is free; free memory or downsample the map");
   }
+}
 
-  // Read the first three channels (or the only one) as float.
-  const int used = channels == 1 ? 1 : 3;
-  const std::size_t texels = std::size_t(w) * std::size_t(h);
-  std::vector<float> raw;
-  try {
-    raw.resize(texels * std::size_t(used));
-    if (!in->read_image(0, 0, 0, used, OIIO::TypeDesc::FLOAT, raw.data())) {
-      fail(path,
-           "cannot read the pixels: " + in->geterror() + "; the file is damaged, re-export it");
-    }
-  } catch (const std::bad_alloc&) {
-    fail(path, size + " texels are too large to load into memory; downsample the map");
-  } catch (const std::length_error&) {
-    fail(path, size + " texels are too large to load into memory; downsample the map");
-  }
-  const std::string format = in->format_name();
-  in->close();
-
+// Float texels to linear RGB: grey to RGB, NaN/Inf refused, negatives clamped, decoded.
+void decode(const std::filesystem::path& path, const std::vector<float>& raw, int used,
+            const OIIO::ImageSpec& spec, Image& image) {
   float gamma = 1.0f;
   const Encoding encoding = encoding_of(spec, &gamma);
-
-  std::vector<Rgb> rgb(texels);
-  std::size_t bad = 0, first_bad = 0, negative = 0;
+  const std::size_t texels = std::size_t(image.width) * std::size_t(image.height);
+  image.rgb.resize(texels);
+  std::size_t bad = 0, first_bad = 0;
   for (std::size_t i = 0; i < texels; ++i) {
     Rgb t = used == 1 ? Rgb::Constant(raw[i]) : Rgb(raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]);
     if (!t.allFinite()) {
@@ -355,7 +213,7 @@ Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
       continue;
     }
     if ((t.array() < 0.0f).any()) {
-      ++negative;
+      ++image.negative;
       t = t.cwiseMax(0.0f);
     }
     if (encoding == Encoding::kSrgb) {
@@ -363,33 +221,196 @@ Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
     } else if (encoding == Encoding::kGamma) {
       for (int c = 0; c < 3; ++c) t[c] = std::pow(t[c], gamma);
     }
-    rgb[i] = t;
+    image.rgb[i] = t;
   }
   if (bad > 0) {
     std::ostringstream msg;
     msg << bad << " texel" << (bad == 1 ? " is" : "s are") << " NaN or Inf (the first at pixel ("
-        << first_bad % std::size_t(w) << ", " << first_bad / std::size_t(w)
+        << first_bad % std::size_t(image.width) << ", " << first_bad / std::size_t(image.width)
         << ")); the map is corrupt, re-export it";
     fail(path, msg.str());
   }
+}
 
-  int out_w = w, out_h = h;
-  if (layout == Layout::kAngular) {
-    rgb = angular_to_latlong(rgb, w);
-    out_w = 2 * w;
-    out_h = w;
+Image read_image(const std::filesystem::path& path) {
+  const std::uintmax_t file_size = check_file(path);
+  std::unique_ptr<OIIO::ImageInput> in;
+  try {
+    in = OIIO::ImageInput::open(path.string());
+  } catch (const std::bad_alloc&) {
+    fail(path, "its header asks for more memory than there is; the file is damaged, re-export it");
   }
+  if (!in) fail(path, "cannot be read as an image: " + OIIO::geterror());
+  const OIIO::ImageSpec spec = in->spec();
+  check_spec(path, spec, file_size);
+  Image image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.channels = spec.nchannels;
+  // Read the first three channels (or the only one) as float.
+  const int used = image.channels == 1 ? 1 : 3;
+  const std::string too_large = std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                " texels are too large to load into memory; downsample the map";
+  std::vector<float> raw;
+  try {
+    raw.resize(std::size_t(image.width) * std::size_t(image.height) * std::size_t(used));
+    if (!in->read_image(0, 0, 0, used, OIIO::TypeDesc::FLOAT, raw.data())) {
+      fail(path,
+           "cannot read the pixels: " + in->geterror() + "; the file is damaged, re-export it");
+    }
+  } catch (const std::bad_alloc&) {
+    fail(path, too_large);
+  } catch (const std::length_error&) {
+    fail(path, too_large);
+  }
+  image.format = in->format_name();
+  in->close();
+  decode(path, raw, used, spec, image);
+  return image;
+}
 
-  if (report) {
-    report->path = path.string();
-    report->format = format;
-    report->file_width = w;
-    report->file_height = h;
-    report->file_channels = channels;
-    report->layout = layout;
-    report->negative_texels_clamped = negative;
+// --- Six face files ------------------------------------------------------------------------
+
+constexpr std::string_view kFacePlaceholder = "{face}";
+
+bool names_face_set(const std::filesystem::path& path) {
+  std::error_code ec;
+  return path.string().find(kFacePlaceholder) != std::string::npos ||
+         std::filesystem::is_directory(path, ec);
+}
+
+// The file of `face` in a set: the pattern with {face} replaced, or the one file in the
+// folder whose name without extension is the face's name.
+std::filesystem::path face_file(const std::filesystem::path& set, int face) {
+  const std::string name = cube_face_name(face);
+  std::string pattern = set.string();
+  if (const std::size_t at = pattern.find(kFacePlaceholder); at != std::string::npos) {
+    return pattern.replace(at, kFacePlaceholder.size(), name);
   }
-  return Probe(out_w, out_h, std::move(rgb), path.stem().string());
+  std::vector<std::filesystem::path> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(set, ec)) {
+    if (entry.path().stem() == name) found.push_back(entry.path());
+  }
+  if (found.size() != 1) {
+    fail(set, found.empty() ? "is a folder without a " + name +
+                                  ".* face file; a six-face cube map needs px, nx, py, ny, "
+                                  "pz and nz (for example px.exr)"
+                            : "holds several " + name + ".* files; keep one per face");
+  }
+  return found[0];
+}
+
+CubeMap read_face_set(const std::filesystem::path& set, LoadReport* report) {
+  std::array<std::vector<Rgb>, kCubeFaces> faces;
+  int size = 0;
+  for (int f = 0; f < kCubeFaces; ++f) {
+    const std::filesystem::path file = face_file(set, f);
+    Image image = read_image(file);
+    if (image.width != image.height) {
+      fail(file, std::to_string(image.width) + "x" + std::to_string(image.height) +
+                     " is not square; every cube face must be N x N");
+    }
+    if (f > 0 && image.width != size) {
+      fail(file, "is " + std::to_string(image.width) + " texels wide but face px is " +
+                     std::to_string(size) + "; every cube face must be the same size");
+    }
+    size = image.width;
+    faces[std::size_t(f)] = std::move(image.rgb);
+    if (report) {
+      report->format = image.format;
+      report->file_channels = image.channels;
+      report->negative_texels_clamped += image.negative;
+    }
+  }
+  if (report) report->file_width = report->file_height = size;
+  return CubeMap(size, std::move(faces));
+}
+
+// The layout of one image file: forced, or by aspect ratio.
+Layout choose_layout(const std::filesystem::path& path, Layout forced, int w, int h) {
+  const std::string size = std::to_string(w) + "x" + std::to_string(h);
+  const bool latlong = w == 2 * h, square = w == h;
+  const bool cross = (3 * w == 4 * h && w % 4 == 0) || (4 * w == 3 * h && w % 3 == 0);
+  switch (forced) {
+    case Layout::kLatLong:
+      if (!latlong) fail(path, size + " is not 2:1, but the layout was forced to lat-long");
+      return forced;
+    case Layout::kAngular:
+      if (!square) fail(path, size + " is not square, but the layout was forced to angular");
+      return forced;
+    case Layout::kCross:
+      if (!cross) {
+        fail(path, size +
+                       " is neither a 4:3 horizontal nor a 3:4 vertical cross of square "
+                       "faces, but the layout was forced to cross");
+      }
+      return forced;
+    case Layout::kFaces:
+      fail(path,
+           "the layout was forced to faces, which needs a folder holding px, nx, py, ny, "
+           "pz and nz, or a file name with {face} in it");
+    case Layout::kAuto:
+      break;
+  }
+  if (latlong) return Layout::kLatLong;
+  if (square) return Layout::kAngular;
+  if (cross) return Layout::kCross;
+  fail(path, size +
+                 " is neither a 2:1 lat-long map, a square angular map nor a 4:3 or 3:4 cube "
+                 "cross; crop or resample it to one of those");
+}
+
+}  // namespace
+
+const char* layout_name(Layout layout) {
+  switch (layout) {
+    case Layout::kAuto:
+      return "auto";
+    case Layout::kLatLong:
+      return "lat-long";
+    case Layout::kAngular:
+      return "angular";
+    case Layout::kCross:
+      return "cube cross";
+    case Layout::kFaces:
+      return "cube faces";
+  }
+  return "unknown";
+}
+
+Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
+                 LoadReport* report) {
+  LoadReport local;
+  LoadReport& r = report ? *report : local;
+  r = LoadReport{};
+  r.path = path.string();
+  const std::string name = path.stem().string();
+  if (names_face_set(path) && options.layout != Layout::kLatLong &&
+      options.layout != Layout::kAngular && options.layout != Layout::kCross) {
+    r.layout = Layout::kFaces;
+    r.cube = std::make_shared<const CubeMap>(read_face_set(path, &r));
+    return cube_to_latlong(*r.cube, path.filename().string());
+  }
+  Image image = read_image(path);
+  r.format = image.format;
+  r.file_width = image.width;
+  r.file_height = image.height;
+  r.file_channels = image.channels;
+  r.negative_texels_clamped = image.negative;
+  r.layout = choose_layout(path, options.layout, image.width, image.height);
+  switch (r.layout) {
+    case Layout::kAngular:
+      return Probe(2 * image.width, image.width, angular_to_latlong(image.rgb, image.width), name);
+    case Layout::kCross: {
+      r.cross = image.width > image.height ? CrossKind::kHorizontal : CrossKind::kVertical;
+      r.cube = std::make_shared<const CubeMap>(
+          cube_from_cross(image.rgb, image.width, image.height, r.cross));
+      return cube_to_latlong(*r.cube, name);
+    }
+    default:
+      return Probe(image.width, image.height, std::move(image.rgb), name);
+  }
 }
 
 }  // namespace probes
