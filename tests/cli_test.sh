@@ -221,6 +221,18 @@ if [[ -f $forest ]]; then
   for entry in "$tmp"/rl_cache/cpca-*.prtc; do flip "$entry" $(($(stat -c %s "$entry") - 3)); done
   run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*payload* && $out == *"bake        cached"* && $out == *"compress    compressed"* ]]; check "relight: a damaged .prtc payload is rebuilt ($err)" $?
   run "${rl[@]}"; expect_code 0 && [[ $out == *"compress    cached"* && $err != *unusable* ]]; check "relight: the rebuilt .prtc is used" $?
+  # The summary beside a cached compression is one JSON object, read back with the JSON
+  # library: a hostile one is damage like any other, reported and rebuilt. First valid JSON
+  # whose value is a string of quotes, backslashes and a control character, then raw control
+  # and non-UTF-8 bytes that are no JSON at all.
+  summaries=("$tmp"/rl_cache/cpca-*.summary)
+  v=$(jget "${summaries[0]}" /relative_error) && awk -v v="$v" 'BEGIN { exit !(v > 0) }'; check "relight: the cached .summary is JSON ($v)" $?
+  printf '{"clustering_seconds": "\\"\\\\\\u0001", "average_se": 1, "relative_error": 1}' >"${summaries[0]}"
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*summary*clustering_seconds* && $out == *"compress    compressed"* ]]; check "relight: a .summary holding a hostile string is reported and rebuilt ($err)" $?
+  printf '{"clustering_seconds": "\001\377\376", "average_se": 1, "relative_error": 1}' >"${summaries[0]}"
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*summary* && $out == *"compress    compressed"* ]]; check "relight: a .summary of raw control and non-UTF-8 bytes is reported and rebuilt ($err)" $?
+  v=$(jget "${summaries[0]}" /average_se) && awk -v v="$v" 'BEGIN { exit !(v > 0) }'; check "relight: the rebuilt .summary is JSON again ($v)" $?
+  run "${rl[@]}"; expect_code 0 && [[ $out == *"compress    cached"* && $err != *unusable* ]]; check "relight: the rebuilt .summary is used" $?
   for entry in "$tmp"/rl_cache/bake-*.prtx; do flip "$entry" 200; done
   run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*payload* && $out == *"bake        baked"* ]]; check "relight: a damaged .prtx payload is rebuilt although its .prtc exists ($err)" $?
   for entry in "$tmp"/rl_cache/bake-*.prtx; do flip "$entry" 200; done
@@ -235,6 +247,11 @@ if [[ -f $forest ]]; then
   printf 'partial' >"$tmp/rl_cache/.cpca-0123.prtc.tmp-$$-78"
   run "${rl[@]}"; expect_code 0 && [[ ! -e $tmp/rl_cache/.bake-0123.prtx.tmp-$gone-77 && -e $tmp/rl_cache/.cpca-0123.prtc.tmp-$$-78 && $err == *"interrupted run"* ]]; check "relight: stale cache temporaries swept, live ones kept" $?
   rm -f "$tmp/rl_cache/.cpca-0123.prtc.tmp-$$-78"
+  # Image temporaries (named with the writer's pid and the extension) in the --out folder.
+  printf 'partial' >"$tmp/rl/.frame_0000.exr.tmp-$gone-5.exr"
+  printf 'partial' >"$tmp/rl/.frame_0001.png.tmp-$$-6.png"
+  run "${rl[@]}"; expect_code 0 && [[ ! -e $tmp/rl/.frame_0000.exr.tmp-$gone-5.exr && -e $tmp/rl/.frame_0001.png.tmp-$$-6.png && $err == *".frame_0000.exr.tmp-$gone-5.exr, left by an interrupted run"* ]]; check "relight: stale image temporaries in --out swept at start, live ones kept ($err)" $?
+  rm -f "$tmp/rl/.frame_0001.png.tmp-$$-6.png"
   mkdir -p "$tmp/outdir" && printf 'partial' >"$tmp/outdir/.old.prtx.tmp-$gone-5"
   run bake "$tmp/cube.obj" -o "$tmp/outdir/cube.prtx" --order 2 --samples 16 --bounces 0 --quiet
   expect_code 0 && [[ ! -e $tmp/outdir/.old.prtx.tmp-$gone-5 && -s $tmp/outdir/cube.prtx ]]; check "bake: stale temporaries in the output folder swept" $?
@@ -267,6 +284,22 @@ if [[ -f $forest ]]; then
   run overdraw "$dir/m$hostile.obj" --probe "$probe" --order 2 --samples 16 --bounces 0 --clusters 2 --pcs 2 --rows original --strategies order --budgets thesis --no-modes --frames 1 --warmup 0 --width 32 --height 24 --cache "$dir/cache" --out "$dir/od" --json -q
   expect_code 0 && [[ $(jget - /mesh <<<"$out") == "$dir/m$hostile.obj" ]]; check "hostile names: overdraw --json parses, names intact ($err)" $?
   [[ $(jget "$dir/od/overdraw.json" /probe) == "$dir/p$hostile"$'\xef\xbf\xbd\xef\xbf\xbd.exr' ]]; check "hostile names: overdraw.json parses, invalid bytes replaced" $?
+fi
+
+# Cube-map probes through the commands: a 4:3 render read back as a horizontal cross, and six
+# square renders as a face set (a folder, or a {face} name); prtr probe projects the cube,
+# render lights with it, a missing face is named.
+if [[ -f $forest && -s $tmp/cube.prtc ]]; then
+  rr=(render "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --frames 1 --warmup 0 -q)
+  run "${rr[@]}" --probe "$forest" -o "$tmp/cross.exr" --width 48 --height 36
+  run probe "$tmp/cross.exr" --order 2; expect_code 0 && [[ $out == *"cube cross layout (horizontal)"* && $out == *"lat-long    48 x 24"* && $out == *"exact solid angles"* && $out == *"differs by at most"* ]]; check "probe: a 4:3 EXR is a horizontal cross, projected per texel ($err)" $?
+  run "${rr[@]}" --probe "$tmp/cross.exr" -o "$tmp/lit_by_cross.exr" --width 32 --height 24; expect_code 0 && [[ -s $tmp/lit_by_cross.exr ]]; check "render: lights with a cross probe ($err)" $?
+  mkdir -p "$tmp/faces" && run "${rr[@]}" --probe "$forest" -o "$tmp/face.exr" --width 16 --height 16
+  for f in px nx py ny pz nz; do cp "$tmp/face.exr" "$tmp/faces/$f.exr"; done
+  run probe "$tmp/faces" --order 1; expect_code 0 && [[ $out == *"cube faces layout"* && $out == *"lat-long    64 x 32"* ]]; check "probe: a folder of six faces ($err)" $?
+  run probe "$tmp/faces/{face}.exr" --order 1; expect_code 0 && [[ $out == *"cube faces layout"* ]]; check "probe: a {face} name ($err)" $?
+  rm "$tmp/faces/nz.exr"
+  run probe "$tmp/faces"; expect_code 1 && [[ $err == *faces* && $err == *nz* ]]; check "probe: a missing face is named ($err)" $?
 fi
 
 # Floating-point flags refuse NaN and infinity where they are parsed (CLI::Range alone lets

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -285,6 +286,47 @@ TEST(HostileProbe, ExrAttributeClaimingGigabytes) {
   expect_probe_error(write_file("preview.exr", preview), "attribute 'preview'");
 }
 
+// A minimal single-part scan-line header: three half channels, the given data window and
+// compression, and nothing after it but `tail` bytes.
+std::string exr_scanlines(std::int32_t width, std::int32_t height, char compression,
+                          std::size_t tail) {
+  std::string channels;
+  for (const char* c : {"B", "G", "R"}) {
+    channels += std::string(c) + '\0' + bytes_of(std::int32_t(1)) + std::string(4, '\0') +
+                bytes_of(std::int32_t(1)) + bytes_of(std::int32_t(1));
+  }
+  channels += '\0';
+  const std::string window = bytes_of(std::int32_t(0)) + bytes_of(std::int32_t(0)) +
+                             bytes_of(width - 1) + bytes_of(height - 1);
+  std::string exr = std::string("\x76\x2f\x31\x01", 4) + bytes_of(std::uint32_t(2));
+  exr += exr_attribute("channels", "chlist", std::int32_t(channels.size()), channels);
+  exr += exr_attribute("compression", "compression", 1, std::string(1, compression));
+  exr += exr_attribute("dataWindow", "box2i", 16, window);
+  exr += exr_attribute("displayWindow", "box2i", 16, window);
+  exr += exr_attribute("lineOrder", "lineOrder", 1, std::string(1, '\0'));
+  return exr + '\0' + std::string(tail, '\0');
+}
+
+TEST(HostileProbe, ExrDataWindowSizingOpenExrBuffers) {
+  // Found by fuzz_probe_exr: a 2 KB file whose data window is 16.5 million texels wide made
+  // OpenEXR's ZIP decompressor allocate 16 scan lines of it, 1.5 GB, while opening the file.
+  expect_probe_error(write_file("wide.exr", exr_scanlines(16514824, 4, 3, 1800)),
+                     "block of scan lines");
+  // DWAB's 256-line blocks: 4 M texels wide is only 24 MB of image but 6 GB per block.
+  expect_probe_error(write_file("dwab.exr", exr_scanlines(4000000, 1, 9, 1800)),
+                     "block of scan lines");
+  // A tall window needs one 8-byte offset per chunk, which OpenEXR allocates before reading.
+  expect_probe_error(write_file("tall.exr", exr_scanlines(1, 196605012, 0, 64)), "offset table");
+  expect_probe_error(write_file("method.exr", exr_scanlines(8, 4, 42, 64)), "compression method");
+  // The same header with an honest size is not refused by the guard: OpenImageIO opens it and
+  // fails on the missing pixels instead.
+  const std::string honest =
+      error_of([&] { probes::load_probe(write_file("honest.exr", exr_scanlines(8, 4, 0, 32))); });
+  EXPECT_TRUE(contains(honest, "honest.exr")) << honest;
+  EXPECT_FALSE(contains(honest, "OpenEXR header")) << honest;
+  EXPECT_FALSE(contains(honest, "offset table")) << honest;
+}
+
 // --- Stale temporaries ----------------------------------------------------------------------
 
 pid_t dead_pid() {
@@ -319,10 +361,32 @@ TEST(StaleTemporaries, OnlyThoseOfFinishedProcessesAreSwept) {
   EXPECT_EQ(common::sweep_stale_temporaries(dir).size(), 1u);
   EXPECT_FALSE(fs::exists(live));
 
+  // Image writers keep the extension (OpenImageIO picks the format from it): the same rule.
+  const fs::path image_stale =
+      touch(".frame_0001.exr.tmp-" + std::to_string(dead_pid()) + "-9.exr");
+  const fs::path image_live =
+      touch(".frame_0002.png.tmp-" + std::to_string(::getppid()) + "-9.png");
+  const fs::path not_ours = touch(".frame.exr.tmp-" + std::to_string(dead_pid()) + "-9.e-x");
+  EXPECT_EQ(common::sweep_stale_temporaries(dir), std::vector<fs::path>{image_stale});
+  EXPECT_TRUE(fs::exists(image_live));
+  EXPECT_TRUE(fs::exists(not_ours));
+
   // Writing a file sweeps its directory.
   const fs::path again = touch(".x.tmp-" + std::to_string(dead_pid()) + "-1");
   common::write_file_atomically(dir / "x", "y", 1);
   EXPECT_FALSE(fs::exists(again));
+}
+
+TEST(StaleTemporaries, TemporaryPathNamesTheWriterAndKeepsTheExtensionOnRequest) {
+  const fs::path dir = test_support::scratch("robustness", "names");
+  const std::string pid = std::to_string(::getpid());
+  const fs::path plain = common::temporary_path(dir / "bake.prtx");
+  const fs::path image = common::temporary_path(dir / "frame.exr", /*keep_extension=*/true);
+  EXPECT_EQ(plain.parent_path(), dir);
+  EXPECT_EQ(plain.filename().string().rfind(".bake.prtx.tmp-" + pid + "-", 0), 0u) << plain;
+  EXPECT_EQ(image.filename().string().rfind(".frame.exr.tmp-" + pid + "-", 0), 0u) << image;
+  EXPECT_EQ(image.extension(), ".exr");
+  EXPECT_NE(common::temporary_path(dir / "bake.prtx"), plain);  // a fresh name each time
 }
 
 }  // namespace

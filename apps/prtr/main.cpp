@@ -1,6 +1,7 @@
 // prtr: the command-line front end of the PRT engine. One binary, one subcommand per
 // workflow; see README.md.
 #include "commands.h"
+#include "start_sweep.h"
 
 #include <cstdio>
 #include <exception>
@@ -35,7 +36,10 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   try {
-    for (CLI::App* sub : app.get_subcommands()) runners.at(sub)();
+    for (CLI::App* sub : app.get_subcommands()) {
+      prtr_app::sweep_command_folders(*sub);
+      runners.at(sub)();
+    }
   } catch (const prtr_app::UsageError& e) {
     std::fprintf(stderr, "prtr: usage error: %s\n", e.what());
     return 2;

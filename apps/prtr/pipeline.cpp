@@ -3,9 +3,11 @@
 #include "common/atomic_file.h"
 #include "common/hash.h"
 #include "cpca/compressed_file.h"
+#include "json_output.h"
 #include "progress_bar.h"
 #include "prt/transfer_file.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -119,6 +121,36 @@ void sweep(const fs::path& dir) {
   }
 }
 
+// A compression's summary is one JSON object (see pipeline.h). Anything else -- a missing file,
+// text that does not parse, a missing key, a value that is not a finite number -- is damage.
+CompressionSummary read_summary(const fs::path& path) {
+  const auto damaged = [&](const std::string& why) {
+    return std::runtime_error("its summary " + path.string() + " is missing or damaged (" + why +
+                              ")");
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw damaged("cannot be opened");
+  const Json json = Json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (!json.is_object()) throw damaged("not a JSON object");
+  const auto number = [&](const char* key) {
+    const auto it = json.find(key);
+    if (it == json.end() || !it->is_number() || !std::isfinite(it->get<double>())) {
+      throw damaged(std::string("no finite number '") + key + "'");
+    }
+    return it->get<double>();
+  };
+  return {number("clustering_seconds"), number("average_se"), number("relative_error")};
+}
+
+void write_summary(const fs::path& path, const CompressionSummary& s) {
+  Json json;
+  json["clustering_seconds"] = s.clustering_seconds;
+  json["average_se"] = s.average_se;
+  json["relative_error"] = s.relative_error;
+  const std::string text = dump_json(json) + "\n";
+  common::write_file_atomically(path, text.data(), text.size());
+}
+
 void discard(const fs::path& entry, const std::exception& why) {
   std::fprintf(stderr, "prtr: cache entry %s is unusable (%s); removing and rebuilding it\n",
                entry.string().c_str(), why.what());
@@ -185,10 +217,7 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
       const cpca::CompressedSet set = cpca::read_compressed(r.path);
       if (set.transfer_hash != header.payload_checksum)
         throw std::runtime_error("compressed from another bake");
-      std::ifstream in(summary);
-      CompressionSummary& m = r.summary;
-      if (!(in >> m.clustering_seconds >> m.average_se >> m.relative_error))
-        throw std::runtime_error("its summary " + summary.string() + " is missing or damaged");
+      r.summary = read_summary(summary);
       r.hit = true;
       return r;
     } catch (const std::exception& e) {
@@ -201,10 +230,7 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
   cpca::write_compressed(r.path, run_compress(transfer, mesh, mesh_path, o, quiet, &report));
   r.summary = {report.clustering_seconds(), report.error.average_squared_error,
                report.error.relative_error};
-  char text[128];
-  const int n = std::snprintf(text, sizeof text, "%.9g %.9g %.9g\n", r.summary.clustering_seconds,
-                              r.summary.average_se, r.summary.relative_error);
-  common::write_file_atomically(summary, text, std::size_t(n));
+  write_summary(summary, r.summary);
   return r;
 }
 

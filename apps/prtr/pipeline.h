@@ -6,7 +6,8 @@
 // ~/.cache/prtr), named by an FNV-1a hash of everything that determines them:
 //   bake-<hash>.prtx   mesh content hash + every bake option
 //   cpca-<hash>.prtc   transfer payload checksum + every compression option
-//   cpca-<hash>.summary  that compression's clustering time and errors
+//   cpca-<hash>.summary  that compression's clustering time and errors, one JSON object:
+//                        {"clustering_seconds": s, "average_se": e, "relative_error": r}
 // Entries are written atomically, so an interrupted run leaves no entry (never half of one),
 // and the temporaries of runs killed mid-write are swept on the next lookup. An entry is read
 // in full, payload checksum included, before it is trusted; one that fails is reported,

@@ -4,6 +4,8 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <chrono>
@@ -21,21 +23,29 @@ std::string errno_text() {
 constexpr std::string_view kTempMarker = ".tmp-";
 constexpr auto kAlwaysStaleAfter = std::chrono::hours(24);
 
-// The pid in ".<name>.tmp-<pid>-<n>", or 0 when `file` is not named like our temporaries.
+// The pid in ".<name>.tmp-<pid>-<n>" or ".<name>.tmp-<pid>-<n>.<ext>" (see temporary_path),
+// or 0 when `file` is not named like our temporaries.
 pid_t temporary_owner(const std::string& file) {
   if (file.size() < 2 || file[0] != '.') return 0;
   const std::size_t marker = file.rfind(kTempMarker);
   if (marker == std::string::npos || marker < 2) return 0;
-  const std::string_view rest = std::string_view(file).substr(marker + kTempMarker.size());
+  std::string_view rest = std::string_view(file).substr(marker + kTempMarker.size());
   const std::size_t dash = rest.find('-');
   if (dash == std::string_view::npos || dash == 0 || dash + 1 == rest.size()) return 0;
   long pid = 0;
   const auto [end, ec] = std::from_chars(rest.data(), rest.data() + dash, pid);
   if (ec != std::errc() || end != rest.data() + dash || pid <= 0) return 0;
+  rest.remove_prefix(dash + 1);
+  // An extension, letters and digits only, may follow the number.
+  if (const std::size_t dot = rest.find('.'); dot != std::string_view::npos) {
+    const std::string_view ext = rest.substr(dot + 1);
+    const auto alnum = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
+    if (ext.empty() || !std::all_of(ext.begin(), ext.end(), alnum)) return 0;
+    rest = rest.substr(0, dot);
+  }
   unsigned long suffix = 0;
-  const auto [end2, ec2] =
-      std::from_chars(rest.data() + dash + 1, rest.data() + rest.size(), suffix);
-  if (ec2 != std::errc() || end2 != rest.data() + rest.size()) return 0;
+  const auto [end2, ec2] = std::from_chars(rest.data(), rest.data() + rest.size(), suffix);
+  if (rest.empty() || ec2 != std::errc() || end2 != rest.data() + rest.size()) return 0;
   return static_cast<pid_t>(pid);
 }
 
@@ -67,6 +77,19 @@ std::vector<std::filesystem::path> sweep_stale_temporaries(const std::filesystem
   return removed;
 }
 
+std::filesystem::path temporary_path(const std::filesystem::path& target, bool keep_extension) {
+  static thread_local std::mt19937 engine(std::random_device{}());
+  // Built with append: GCC 12 reports a false -Wrestrict on chained operator+ here.
+  std::string name = ".";
+  name.append(target.filename().string())
+      .append(kTempMarker)
+      .append(std::to_string(::getpid()))
+      .append("-")
+      .append(std::to_string(engine() & 0xffffff));
+  if (keep_extension) name.append(target.extension().string());
+  return (target.has_parent_path() ? target.parent_path() : std::filesystem::path(".")) / name;
+}
+
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   const std::filesystem::path dir =
       target_.has_parent_path() ? target_.parent_path() : std::filesystem::path(".");
@@ -79,16 +102,8 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
   // know the directory is in use again.
   sweep_stale_temporaries(dir);
   // A unique name in the same directory, so the final rename stays on one file system.
-  std::random_device rd;
   for (int attempt = 0; attempt < 16 && fd_ < 0; ++attempt) {
-    // Built with append: GCC 12 reports a false -Wrestrict on chained operator+ here.
-    std::string name = ".";
-    name.append(target_.filename().string())
-        .append(kTempMarker)
-        .append(std::to_string(::getpid()))
-        .append("-")
-        .append(std::to_string(rd() & 0xffffff));
-    temp_ = dir / name;
+    temp_ = temporary_path(target_);
     fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd_ < 0 && errno != EEXIST) break;
   }

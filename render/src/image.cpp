@@ -1,5 +1,7 @@
 #include "render/image.h"
 
+#include "common/atomic_file.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -23,13 +25,8 @@ void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const v
   if (!fs::is_directory(dir))
     throw ImageError(std::string("cannot write ") + what + " " + path.string() + ": directory " +
                      dir.string() + " does not exist; create it first");
-  std::random_device rd;
-  std::string name = ".";
-  name += path.stem().string();
-  name += ".tmp";
-  name += std::to_string(rd() % 1000000);
-  name += path.extension().string();
-  const fs::path temp = dir / name;
+  // Named like AtomicFile's temporaries (with the pid), so a killed run's are swept.
+  const fs::path temp = common::temporary_path(path, /*keep_extension=*/true);
   auto fail = [&](const std::string& why) {
     std::error_code ec;
     fs::remove(temp, ec);

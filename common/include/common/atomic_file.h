@@ -43,13 +43,21 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-// Removes the temporaries AtomicFile left in `dir` when its process died before commit() or
-// its destructor ran (kill -9, a crash, power loss): files named .<name>.tmp-<pid>-<n> whose
+// Removes the temporaries AtomicFile (or another user of temporary_path) left in `dir` when its
+// process died before commit() or its destructor ran (kill -9, a crash, power loss): files
+// named by temporary_path whose
 // process no longer runs, or older than a day whatever their pid says (pids are reused, and
 // a file from another machine or container names a pid that means nothing here). A writer
 // that is still running is never disturbed. Returns the files removed; problems are ignored,
 // since a missed sweep only costs disk space.
 std::vector<std::filesystem::path> sweep_stale_temporaries(const std::filesystem::path& dir);
+
+// A fresh temporary name next to `target`: .<name>.tmp-<pid>-<n>, with the target's extension
+// appended when `keep_extension` (for writers that choose the format by the name, such as
+// OpenImageIO's). Carrying the pid is what lets sweep_stale_temporaries tell a dead writer's
+// file from a live one's.
+std::filesystem::path temporary_path(const std::filesystem::path& target,
+                                     bool keep_extension = false);
 
 // Convenience: the whole file from one buffer.
 void write_file_atomically(const std::filesystem::path& target, const void* data,
