@@ -47,6 +47,12 @@ inline const std::filesystem::path& write_input(const std::uint8_t* data, std::s
   const std::filesystem::path& path = scratch_path(extension);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+  // A short write (the scratch file system filled up) would feed the loader another input
+  // than libFuzzer recorded; stop rather than report findings that do not reproduce.
+  if (!out.flush()) {
+    std::fprintf(stderr, "fuzz: cannot write %s\n", path.c_str());
+    std::abort();
+  }
   return path;
 }
 
