@@ -2,6 +2,7 @@
 // write_transfer: the same bytes, whatever the block size, with and without bounces.
 #include "prt/bake.h"
 #include "prt/transfer_file.h"
+#include "prt/transfer_shard.h"
 
 #include "meshes/procedural.h"
 #include "test_support.h"
@@ -9,7 +10,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -85,6 +88,94 @@ TEST(StreamingBake, TheFileReadsBackAndAFailedBakeLeavesNothing) {
   o.order = 0;  // invalid: refused before anything is written
   EXPECT_THROW(prt::bake_to_file(torus(), o, dir / "bad.prtx", 16), std::invalid_argument);
   EXPECT_EQ(files_in(dir), 0u);
+}
+
+// Bakes shards k/n of `o` (block 16) into the scratch directory; returns their paths.
+std::vector<fs::path> bake_shards(const meshes::Mesh& mesh, const prt::BakeOptions& o,
+                                  std::uint32_t n, const std::string& name) {
+  std::vector<fs::path> paths;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    paths.push_back(test_support::scratch("bake_stream", name + "_" + std::to_string(k)));
+    prt::bake_shard_to_file(mesh, o, paths.back(), k, n, 16);
+  }
+  return paths;
+}
+
+// The message of the TransferFileError merge_shards throws, or "" if it merged.
+std::string merge_error(const std::vector<fs::path>& shards, const fs::path& out) {
+  try {
+    prt::merge_shards(shards, out);
+  } catch (const prt::TransferFileError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Shards, MergedShardsEqualTheSingleBakeInAnyOrder) {
+  const meshes::Mesh mesh = torus();
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 0);
+  const fs::path single = test_support::scratch("bake_stream", "single.prtx");
+  prt::write_transfer(single, prt::bake(mesh, o));
+  // 5 shards of 288 vertices: uneven ranges (57 and 58 vertices), blocks of 16 inside them.
+  std::vector<fs::path> shards = bake_shards(mesh, o, 5, "five");
+  std::swap(shards[0], shards[3]);
+  const fs::path merged = test_support::scratch("bake_stream", "merged.prtx");
+  ASSERT_EQ(merge_error(shards, merged), "");
+  EXPECT_TRUE(test_support::slurp(single) == test_support::slurp(merged));
+  // More shards than some ranges can fill: empty shards merge too.
+  const meshes::Mesh tiny = meshes::make_plane(1.f, 1);  // 4 vertices
+  const fs::path tiny_single = test_support::scratch("bake_stream", "tiny.prtx");
+  prt::write_transfer(tiny_single, prt::bake(tiny, o));
+  ASSERT_EQ(merge_error(bake_shards(tiny, o, 6, "tiny"), merged), "");
+  EXPECT_TRUE(test_support::slurp(tiny_single) == test_support::slurp(merged));
+}
+
+TEST(Shards, MergeRefusesShardsThatDoNotBelongTogether) {
+  const meshes::Mesh mesh = torus();
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 0);
+  const std::vector<fs::path> good = bake_shards(mesh, o, 3, "good");
+  const fs::path out = test_support::scratch("bake_stream", "refused.prtx");
+  fs::remove(out);
+
+  prt::BakeOptions other_seed = o;
+  other_seed.seed = 8;
+  const std::vector<fs::path> seed8 = bake_shards(mesh, other_seed, 3, "seed8");
+  std::string e = merge_error({good[0], seed8[1], good[2]}, out);
+  EXPECT_NE(e.find("different bakes"), std::string::npos) << e;
+  EXPECT_NE(e.find("seed"), std::string::npos) << e;
+
+  const std::vector<fs::path> other_mesh =
+      bake_shards(meshes::make_torus(1.f, 0.3f, 24, 12), o, 3, "mesh");
+  e = merge_error({good[0], other_mesh[1], good[2]}, out);
+  EXPECT_NE(e.find("mesh hash"), std::string::npos) << e;
+
+  e = merge_error({good[0], good[2]}, out);
+  EXPECT_NE(e.find("shard 1/3 is missing"), std::string::npos) << e;
+  e = merge_error({good[0], good[1], good[1], good[2]}, out);
+  EXPECT_NE(e.find("shard 1/3 is given twice"), std::string::npos) << e;
+
+  const std::vector<fs::path> four = bake_shards(mesh, o, 4, "four");
+  e = merge_error({good[0], good[1], four[3]}, out);
+  EXPECT_NE(e.find("same --shard n"), std::string::npos) << e;
+
+  // A damaged payload byte is caught by the shard's checksum, and nothing is written.
+  std::string bytes = test_support::slurp(good[1]);
+  bytes[bytes.size() - 3] ^= 0x40;
+  const fs::path damaged = test_support::scratch("bake_stream", "damaged_shard");
+  std::ofstream(damaged, std::ios::binary) << bytes;
+  e = merge_error({good[0], damaged, good[2]}, out);
+  EXPECT_NE(e.find("damaged"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Shards, BouncesAreRefusedByName) {
+  try {
+    prt::bake_shard_to_file(torus(), small_options(prt::TransferKind::kGlossy, 1),
+                            test_support::scratch("bake_stream", "bounce_shard"), 0, 2);
+    FAIL() << "a shard with bounces was baked";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--bounces 0"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -637,6 +637,7 @@ struct BakeEngine::State {
   ShadowPool shadow_pool;
   BouncePool bounce_pool;
   std::vector<std::uint8_t> flags;
+  std::uint64_t shaded = 0;  // vertices through the shadow pass (a shard's range)
 };
 
 namespace {
@@ -700,6 +701,7 @@ void BakeEngine::shadow(std::uint64_t begin, std::uint64_t end, float* dst,
   const auto start = Clock::now();
   State& st = *state_;
   shadow_range(st.ctx, st.shadow_pool, begin, end, dst, hits, st.flags, st.progress);
+  st.shaded += end - begin;
   st.stats.seconds_shadow += seconds_since(start);
 }
 
@@ -727,7 +729,7 @@ void BakeEngine::finish() {
     occluded += double(s.occluded_count);
   }
   // Over the rays each vertex kept: a moved vertex's first, discarded trace is not counted.
-  const double kept = double(state.ctx.vertex_count) * state.setup.samples;
+  const double kept = double(state.shaded) * state.setup.samples;
   st.occluded_fraction = kept > 0 ? occluded / kept : 0.0;
   st.seconds_total = seconds_since(state.start);
 }

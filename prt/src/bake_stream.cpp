@@ -7,6 +7,7 @@
 #include "common/atomic_file.h"
 #include "common/mapped_file.h"
 #include "prt/transfer_file.h"
+#include "prt/transfer_shard.h"
 
 #include <algorithm>
 #include <memory>
@@ -177,6 +178,41 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
   if (o.bounces > 0) {
     stream_bounces(engine, o.bounces, std::min(v, block), path, *hits, shadow_pass, writer);
   }
+  writer.commit();
+  engine.finish();
+  return shape;
+}
+
+TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const fs::path& path,
+                               std::uint32_t index, std::uint32_t count,
+                               std::uint64_t block_vertices, BakeStats* stats) {
+  if (count == 0 || index >= count) {
+    throw std::invalid_argument("--shard " + std::to_string(index) + "/" + std::to_string(count) +
+                                ": k/n needs 0 <= k < n");
+  }
+  if (o.bounces > 0) {
+    // A bounce reads the previous pass at every vertex its rays hit, anywhere on the mesh,
+    // so a vertex range alone cannot compute it (docs/ARCHITECTURE.md, "Scale").
+    throw std::invalid_argument(
+        "--shard needs --bounces 0: an interreflection pass reads every vertex's previous "
+        "pass; bake with bounces in one process (prtr bake streams, so memory stays bounded)");
+  }
+  BakeStats local_stats;
+  detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
+  const TransferSet shape = engine.shape();
+  const ShardRange range = shard_range(engine.vertex_count(), index, count);
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::uint64_t block =
+      block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex);
+  TransferShardWriter writer(path, shape, range);
+  std::vector<float> buffer(std::min(range.end - range.first, block) * per_vertex);
+  engine.start_pass(0);
+  for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
+    const std::uint64_t end = std::min(range.end, begin + block);
+    engine.shadow(begin, end, buffer.data(), nullptr);
+    writer.append(buffer.data(), (end - begin) * per_vertex);
+  }
+  engine.finish_pass();
   writer.commit();
   engine.finish();
   return shape;

@@ -226,17 +226,12 @@ Header encode_header(const TransferSet& set, std::uint64_t payload_floats,
   return h;
 }
 
-TransferSet read(const fs::path& path, bool with_payload) {
-  const std::string name = path.string();
+// The header's fields, checked: ranges, reserved bytes, payload size, header checksum.
+// `payload_floats` gets the payload size it records.
+TransferSet decode(const Header& h, const std::string& name, std::uint64_t* payload_floats_out) {
   const auto fail = [&](const std::string& problem) {
     return TransferFileError(name + ": " + problem);
   };
-  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
-  if (!opened.problem.empty()) throw fail(opened.problem);
-  std::ifstream& in = opened.stream;
-  const std::uintmax_t size = opened.size;
-  const Header& h = opened.header;
-
   Fields f;
   f.kind = common::get_field<std::uint32_t>(h, kOffKind);
   f.order = common::get_field<std::uint32_t>(h, kOffOrder);
@@ -288,6 +283,22 @@ TransferSet read(const fs::path& path, bool with_payload) {
   }
   if (const std::string problem = common::header_checksum_problem(h, kFormat); !problem.empty())
     throw fail(problem);
+  *payload_floats_out = payload_floats;
+  return set;
+}
+
+TransferSet read(const fs::path& path, bool with_payload) {
+  const std::string name = path.string();
+  const auto fail = [&](const std::string& problem) {
+    return TransferFileError(name + ": " + problem);
+  };
+  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
+  if (!opened.problem.empty()) throw fail(opened.problem);
+  std::ifstream& in = opened.stream;
+  const std::uintmax_t size = opened.size;
+  const Header& h = opened.header;
+  std::uint64_t payload_floats = 0;
+  TransferSet set = decode(h, name, &payload_floats);
   std::uint64_t expected_size = 0;
   if (__builtin_mul_overflow(payload_floats, std::uint64_t(4), &expected_size) ||
       __builtin_add_overflow(expected_size, std::uint64_t(kHeaderBytes), &expected_size)) {
@@ -398,6 +409,27 @@ void TransferFileWriter::commit() {
   }
   ::close(fd);
   file_->commit();  // its fsync covers the header written through the second descriptor
+}
+
+std::array<unsigned char, kTransferHeaderBytes> encode_transfer_header(
+    const TransferSet& shape, std::uint64_t payload_checksum) {
+  std::uint64_t floats = 0;
+  if (const std::string problem = field_problem(fields_of(shape)); !problem.empty())
+    throw std::invalid_argument("cannot encode the transfer header: " + problem);
+  if (!payload_floats_of(shape.vertex_count, shape.floats_per_vertex(), &floats))
+    throw std::invalid_argument("cannot encode the transfer header: too many vertices");
+  return encode_header(shape, floats, payload_checksum);
+}
+
+TransferSet decode_transfer_header(const std::array<unsigned char, kTransferHeaderBytes>& header,
+                                   const std::string& name) {
+  if (std::memcmp(header.data(), kMagic.data(), kMagic.size()) != 0 ||
+      common::get_field<std::uint32_t>(header, 8) != kTransferFileVersion) {
+    throw TransferFileError(name + ": the transfer header inside is not a version " +
+                            std::to_string(kTransferFileVersion) + " .prtx header; " + kRebake);
+  }
+  std::uint64_t floats = 0;
+  return decode(header, name, &floats);
 }
 
 TransferSet read_transfer(const fs::path& path) {

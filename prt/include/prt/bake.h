@@ -115,6 +115,14 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& options,
                          const std::filesystem::path& path, std::uint64_t block_vertices = 0,
                          BakeStats* stats = nullptr);
 
+// Shard `index` of `count` of that bake: its vertex range (prt/transfer_shard.h) into a
+// shard file for prt::merge_shards. Bounces need every vertex's previous pass, so a shard
+// bake refuses bounces > 0 (std::invalid_argument naming --shard).
+TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& options,
+                               const std::filesystem::path& path, std::uint32_t index,
+                               std::uint32_t count, std::uint64_t block_vertices = 0,
+                               BakeStats* stats = nullptr);
+
 // Vertices per block holding about 64 MiB of transfer (a multiple of 64, at least 64).
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex);
 

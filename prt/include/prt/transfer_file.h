@@ -8,10 +8,12 @@
 #include "common/atomic_file.h"
 #include "prt/transfer.h"
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 namespace prt {
 
@@ -48,6 +50,15 @@ class TransferFileWriter {
   std::unique_ptr<common::AtomicFile> file_;
   std::uint64_t expected_ = 0, written_ = 0, hash_ = 0;
 };
+
+// The 128-byte header alone, for containers that carry one (transfer shards,
+// prt/transfer_shard.h). encode throws std::invalid_argument for fields out of range;
+// decode checks it as read_transfer does and throws TransferFileError naming `name`.
+inline constexpr std::size_t kTransferHeaderBytes = 128;
+std::array<unsigned char, kTransferHeaderBytes> encode_transfer_header(
+    const TransferSet& shape, std::uint64_t payload_checksum);
+TransferSet decode_transfer_header(const std::array<unsigned char, kTransferHeaderBytes>& header,
+                                   const std::string& name);
 
 // Reads and validates everything: magic, version, header fields in range, file size equal
 // to header + payload, payload checksum, finite values. Each failure is a TransferFileError
