@@ -19,7 +19,6 @@ struct HitRecord {
   std::int32_t triangle;
   float u, v;
 };
-static_assert(sizeof(HitRecord) == 16 || sizeof(HitRecord) == 12);
 
 // Front-hit records of kChunk consecutive vertices; offsets has one entry per vertex + 1.
 struct HitBlock {
