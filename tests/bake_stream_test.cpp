@@ -44,8 +44,9 @@ std::size_t files_in(const fs::path& dir) {
 
 void expect_same_file(const meshes::Mesh& mesh, const prt::BakeOptions& o, std::uint64_t block,
                       const std::string& name) {
-  const fs::path whole = test_support::scratch("bake_stream", name + "_whole.prtx");
-  const fs::path streamed = test_support::scratch("bake_stream", name + "_streamed.prtx");
+  // A directory per case: ctest runs cases in parallel, and this one counts its files.
+  const fs::path whole = test_support::scratch("bake_stream_" + name, "whole.prtx");
+  const fs::path streamed = test_support::scratch("bake_stream_" + name, "streamed.prtx");
   prt::BakeStats whole_stats, stream_stats;
   prt::write_transfer(whole, prt::bake(mesh, o, &whole_stats));
   const std::size_t before = files_in(streamed.parent_path());
@@ -82,7 +83,7 @@ TEST(StreamingBake, NoBouncesEqualsTheWholeBake) {
 }
 
 TEST(StreamingBake, TheFileReadsBackAndAFailedBakeLeavesNothing) {
-  const fs::path dir = test_support::scratch("bake_stream", "fail");
+  const fs::path dir = test_support::scratch("bake_stream_fail", "dir");
   fs::create_directories(dir);
   prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 1);
   o.order = 0;  // invalid: refused before anything is written
