@@ -1,4 +1,5 @@
-// prtr bake MESH -o FILE: per-vertex SH transfer (shadow + interreflection passes).
+// prtr bake MESH -o FILE: per-vertex SH transfer (shadow + interreflection passes), streamed
+// to the file block by block (prt::bake_to_file), so the payload never sits in memory whole.
 #include "bake_flags.h"
 #include "commands.h"
 #include "meshes/load.h"
@@ -9,15 +10,56 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace prtr_app {
+namespace {
+
+// The bake with a progress bar; memory is bounded by the block, so no estimate is checked.
+// "k/n" as {k, n}; {0, 0} for no shard.
+std::pair<std::uint32_t, std::uint32_t> parse_shard(const std::string& text) {
+  if (text.empty()) return {0, 0};
+  unsigned long k = 0, n = 0;
+  char slash = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%lu%c%lu%c", &k, &slash, &n, &extra) != 3 || slash != '/' ||
+      n == 0 || k >= n || n > 1000000) {
+    throw UsageError("--shard " + text + ": expected k/n with 0 <= k < n (e.g. 0/4)");
+  }
+  return {std::uint32_t(k), std::uint32_t(n)};
+}
+
+prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
+                             const std::string& output, std::uint64_t block,
+                             std::pair<std::uint32_t, std::uint32_t> shard, bool quiet,
+                             prt::BakeStats* stats) {
+  if (shard.second > 0 && options.bounces > 0) {
+    throw UsageError(
+        "--shard needs --bounces 0: an interreflection pass reads every vertex's "
+        "previous pass, so bake bounces in one process (it streams, so memory "
+        "stays bounded)");
+  }
+  ProgressBar bar(quiet);
+  options.progress = [&bar](const prt::BakeProgress& p) {
+    bar.update(p.pass == 0 ? "shadow pass" : "bounce " + std::to_string(p.pass), p.done, p.total);
+  };
+  prt::TransferSet set =
+      shard.second > 0
+          ? prt::bake_shard_to_file(mesh, options, output, shard.first, shard.second, block, stats)
+          : prt::bake_to_file(mesh, options, output, block, stats);
+  bar.finish();
+  return set;
+}
+
+}  // namespace
 
 Runner add_bake_command(CLI::App& app) {
   struct Options {
     std::string mesh, output;
     BakeFlags flags;
     bool quiet = false, json = false;
+    std::uint64_t block = 0;
+    std::string shard;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -25,16 +67,22 @@ Runner add_bake_command(CLI::App& app) {
   cmd->add_option("MESH", opt->mesh, "Mesh file (OBJ, PLY, OFF, STL)")->required();
   cmd->add_option("-o,--output", opt->output, "Transfer file to write (.prtx)")->required();
   add_bake_flags(cmd, opt->flags);
+  cmd->add_option("--block-vertices", opt->block,
+                  "Vertices computed and written per block (0: about 64 MiB of transfer)")
+      ->capture_default_str();
+  cmd->add_option("--shard", opt->shard,
+                  "k/n: bake only shard k (0-based) of n vertex ranges into a shard file for "
+                  "prtr merge (needs --bounces 0)");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress bar");
   cmd->add_flag("--json", opt->json, "Print the summary as one JSON line instead");
 
   return [opt] {
     Options& o = *opt;
-    const prt::BakeOptions options = resolve_bake_flags(o.flags);
+    prt::BakeOptions options = resolve_bake_flags(o.flags);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     prt::BakeStats stats;
-    const prt::TransferSet set = run_bake(mesh, o.mesh, options, o.quiet || o.json, &stats);
-    prt::write_transfer(o.output, set);
+    const prt::TransferSet set = stream_bake(mesh, options, o.output, o.block, parse_shard(o.shard),
+                                             o.quiet || o.json, &stats);
 
     // A sound closed or open surface rarely has a vertex that sees (almost) none of its sky,
     // so these are named: they render black and usually point at broken geometry.
@@ -70,7 +118,7 @@ Runner add_bake_command(CLI::App& app) {
     std::printf("baked       %s -> %s\n", o.mesh.c_str(), o.output.c_str());
     std::printf("transfer    %s, order %d, %d channel(s), %zu vertices, %s\n",
                 prt::transfer_kind_name(set.kind), set.order, set.channels, mesh.vertex_count(),
-                format_bytes(set.data.size() * sizeof(float)).c_str());
+                format_bytes(set.vertex_count * set.floats_per_vertex() * sizeof(float)).c_str());
     std::printf("time        %.2f s total: %.2f s shadow, %.2f s bounces, %.2f s BRDF matrix\n",
                 stats.seconds_total, stats.seconds_shadow, stats.seconds_bounces,
                 stats.seconds_brdf);

@@ -1,9 +1,12 @@
-// prtr mesh FILE: load a mesh the way every later stage will, and print what was found.
+// prtr mesh FILE: load a mesh the way every later stage will, and print what was found;
+// with -o, write it (after --subdivide N rounds of Loop subdivision) as binary PLY.
 #include "commands.h"
+#include "loop_subdivision.h"
 
 #include "meshes/load.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 namespace prtr_app {
@@ -13,6 +16,8 @@ Runner add_mesh_command(CLI::App& app) {
     std::string path;
     double weld = meshes::LoadOptions{}.weld_tolerance;
     std::string normals = "angle";
+    int subdivide = 0;
+    std::string output;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd =
@@ -25,8 +30,18 @@ Runner add_mesh_command(CLI::App& app) {
   cmd->add_option("--normals", opt->normals, "Vertex normal weighting")
       ->check(CLI::IsMember({"angle", "area"}))
       ->capture_default_str();
+  cmd->add_option("--subdivide", opt->subdivide,
+                  "Rounds of Loop subdivision before writing -o (each: ~4x the vertices)")
+      ->check(CLI::Range(0, 6));
+  cmd->add_option("-o,--output", opt->output, "Write the loaded (and subdivided) mesh here (.ply)");
 
   return [opt] {
+    if (opt->subdivide > 0 && opt->output.empty()) {
+      throw UsageError("--subdivide needs -o OUT.ply to write the refined mesh to");
+    }
+    if (!opt->output.empty() && std::filesystem::path(opt->output).extension() != ".ply") {
+      throw UsageError("-o " + opt->output + ": the refined mesh is written as PLY; name it .ply");
+    }
     meshes::LoadOptions options;
     options.weld_tolerance = opt->weld;
     options.normal_weighting =
@@ -53,6 +68,12 @@ Runner add_mesh_command(CLI::App& app) {
     std::printf("area        %.6g\n", area);
     std::printf("hash        %016llx\n",
                 static_cast<unsigned long long>(meshes::content_hash(mesh)));
+    if (opt->output.empty()) return;
+    const meshes::Mesh refined = loop_subdivide(mesh, opt->subdivide);
+    write_ply(opt->output, refined);
+    std::printf("wrote       %s: %d round(s) of Loop subdivision, %zu vertices, %zu triangles\n",
+                opt->output.c_str(), opt->subdivide, refined.vertex_count(),
+                refined.triangle_count());
   };
 }
 

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   add(prtr_app::add_mesh_command);
   add(prtr_app::add_probe_command);
   add(prtr_app::add_bake_command);
+  add(prtr_app::add_merge_command);
   add(prtr_app::add_compress_command);
   add(prtr_app::add_relight_command);
   add(prtr_app::add_overdraw_command);

@@ -2,6 +2,8 @@
 // Kautz & Snyder 2002, section 5). See prt/bake.h for the formulation this file follows.
 #include "prt/bake.h"
 
+#include "bake_engine.h"
+
 #include "prt/ray_scene.h"
 #include "prt/sampling.h"
 #include "prt/sh.h"
@@ -29,7 +31,9 @@ using Clock = std::chrono::steady_clock;
 using MatF = Eigen::MatrixXf;  // column-major
 using RowMatF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-constexpr std::uint64_t kChunk = 64;  // vertices per scheduling unit (and per hit block)
+using detail::HitBlock;
+using detail::HitRecord;
+using detail::kChunk;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -45,19 +49,6 @@ struct Setup {
   Eigen::VectorXf cosine_projection;  // w sum_k z_k y_k: the unoccluded diffuse transfer
   std::vector<MatF> brdf;             // per channel, n x n (glossy only)
   Eigen::Vector3f rho_over_pi;        // diffuse albedo / pi per channel
-};
-
-// An occluded ray that hit the front of a triangle: what a bounce needs of it.
-struct HitRecord {
-  std::uint16_t direction;  // index into Setup::directions
-  std::int32_t triangle;
-  float u, v;
-};
-
-// Front-hit records of kChunk consecutive vertices; offsets has kChunk + 1 entries.
-struct HitBlock {
-  std::vector<HitRecord> records;
-  std::vector<std::uint32_t> offsets;
 };
 
 Eigen::Matrix3f frame_of(const meshes::Mesh& mesh, std::size_t p) {
@@ -297,7 +288,8 @@ struct BakeContext {
   bool glossy = false;
   float offset = 0;  // ray-origin offset in world units
   OriginFaces faces;
-  std::uint64_t vertex_count = 0, chunks = 0;
+  std::uint64_t vertex_count = 0;
+  std::size_t per_vertex = 0, per_channel = 0;  // floats of the output layout
 };
 
 // Per-thread scratch of the shadow pass, allocated once per thread and reused for every vertex.
@@ -331,22 +323,6 @@ struct ShadowScratch {
   std::uint64_t rays_shadow = 0, rays_bounce = 0, occluded_count = 0;
 };
 using ShadowPool = tbb::enumerable_thread_specific<ShadowScratch>;
-
-TransferSet empty_transfer(const meshes::Mesh& mesh, const BakeOptions& o, const Setup& setup,
-                           int channels) {
-  TransferSet out;
-  out.kind = o.kind;
-  out.order = o.order;
-  out.channels = channels;
-  out.vertex_count = mesh.vertex_count();
-  out.samples = setup.samples;
-  out.bounces = o.bounces;
-  out.seed = o.seed;
-  out.material = o.material;
-  out.mesh_hash = meshes::content_hash(mesh);
-  out.data.assign(out.vertex_count * out.floats_per_vertex(), 0.f);
-  return out;
-}
 
 // Start points of p's rays (s.world) into s.origins: each on the face at p's position whose
 // plane the ray rises most steeply above. A vertex on no face starts above itself.
@@ -429,7 +405,7 @@ std::optional<Eigen::Vector3f> escape_origin(const BakeContext& ctx, std::uint64
 }
 
 void glossy_shadow_transfer(const BakeContext& ctx, ShadowScratch& s, int k,
-                            const Eigen::Matrix3f& frame, TransferSet& out, std::uint64_t p) {
+                            const Eigen::Matrix3f& frame, float* dst) {
   const Setup& setup = ctx.setup;
   const int n = setup.n;
   // T = w Y Y^T - w Y_O Y_O^T as a symmetric rank-k update of the lower triangle.
@@ -441,13 +417,13 @@ void glossy_shadow_transfer(const BakeContext& ctx, ShadowScratch& s, int k,
   s.rotation.set(frame.transpose().cast<double>());  // D(F^T): world to local
   multiply_bands_right(s.transfer, s.rotation, s.bands, s.scratch);
   for (int c = 0; c < ctx.channels; ++c) {
-    Eigen::Map<RowMatF> m(out.transfer_data(p, c), n, n);
+    Eigen::Map<RowMatF> m(dst + c * ctx.per_channel, n, n);
     m.noalias() = setup.brdf[c] * s.transfer;
   }
 }
 
 void diffuse_shadow_transfer(const BakeContext& ctx, ShadowScratch& s, int k,
-                             const Eigen::Matrix3f& frame, TransferSet& out, std::uint64_t p) {
+                             const Eigen::Matrix3f& frame, float* dst) {
   const Setup& setup = ctx.setup;
   Eigen::VectorXf& t = s.diffuse_local;
   t = setup.cosine_projection;
@@ -459,7 +435,7 @@ void diffuse_shadow_transfer(const BakeContext& ctx, ShadowScratch& s, int k,
   s.rotation.set(frame.cast<double>());
   s.rotation.apply(t.cast<double>(), s.diffuse_world);
   for (int c = 0; c < ctx.channels; ++c) {
-    Eigen::Map<Eigen::VectorXf>(out.transfer_data(p, c), setup.n) =
+    Eigen::Map<Eigen::VectorXf>(dst + c * ctx.per_channel, setup.n) =
         setup.rho_over_pi[c] * s.diffuse_world.cast<float>();
   }
 }
@@ -489,18 +465,20 @@ void record_front_hits(const BakeContext& ctx, ShadowScratch& s, int k, HitBlock
 // Per-vertex outcome of the shadow pass.
 enum VertexFlag : std::uint8_t { kNearly = 1, kMoved = 2 };
 
-// Direct light: the shadow-pass transfer of every vertex into out, and (with bounces) the
-// front hits each vertex's occluded rays find. flags[p] has kNearly where p sees less than
-// kNearlyOccluded of its rays escape, and kMoved where its origin was moved out of the body.
-void shadow_pass(const BakeContext& ctx, ShadowPool& pool, std::vector<HitBlock>& hit_blocks,
-                 TransferSet& out, std::vector<std::uint8_t>& flags, ProgressReporter& progress) {
-  const bool keep_hits = ctx.options.bounces > 0;
+// Direct light: the shadow-pass transfer of vertices [first, last) into dst, and (with
+// bounces) the front hits each vertex's occluded rays find. flags[p] has kNearly where p
+// sees less than kNearlyOccluded of its rays escape, and kMoved where its origin was moved
+// out of the body.
+void shadow_range(const BakeContext& ctx, ShadowPool& pool, std::uint64_t first, std::uint64_t last,
+                  float* dst, std::vector<HitBlock>* hit_blocks, std::vector<std::uint8_t>& flags,
+                  ProgressReporter& progress) {
   const double visible_floor = kNearlyOccluded * ctx.setup.samples;
-  progress.start_pass(0);
-  tbb::parallel_for(std::uint64_t(0), ctx.chunks, [&](std::uint64_t chunk) {
+  const std::uint64_t chunks = (last - first + kChunk - 1) / kChunk;
+  if (hit_blocks) hit_blocks->assign(chunks, HitBlock{});
+  tbb::parallel_for(std::uint64_t(0), chunks, [&](std::uint64_t chunk) {
     ShadowScratch& s = pool.local();
-    const std::uint64_t begin = chunk * kChunk, end = std::min(ctx.vertex_count, begin + kChunk);
-    HitBlock* block = keep_hits ? &hit_blocks[chunk] : nullptr;
+    const std::uint64_t begin = first + chunk * kChunk, end = std::min(last, begin + kChunk);
+    HitBlock* block = hit_blocks ? &(*hit_blocks)[chunk] : nullptr;
     if (block) block->offsets.assign(1, 0);
     for (std::uint64_t p = begin; p < end; ++p) {
       const Eigen::Matrix3f frame = frame_of(ctx.mesh, p);
@@ -518,16 +496,16 @@ void shadow_pass(const BakeContext& ctx, ShadowPool& pool, std::vector<HitBlock>
       }
       flags[p] = flag;
       s.occluded_count += k;
+      float* out = dst + (p - first) * ctx.per_vertex;
       if (ctx.glossy) {
-        glossy_shadow_transfer(ctx, s, k, frame, out, p);
+        glossy_shadow_transfer(ctx, s, k, frame, out);
       } else {
-        diffuse_shadow_transfer(ctx, s, k, frame, out, p);
+        diffuse_shadow_transfer(ctx, s, k, frame, out);
       }
       if (block) record_front_hits(ctx, s, k, *block);
     }
     progress.add(end - begin);
   });
-  progress.finish_pass();
 }
 
 // Per-thread scratch of the interreflection passes.
@@ -546,9 +524,9 @@ struct BounceScratch {
 };
 using BouncePool = tbb::enumerable_thread_specific<BounceScratch>;
 
-// The previous bounce's transfer, with its layout.
+// The previous bounce's transfer of every vertex, with its layout.
 struct BounceSource {
-  const std::vector<float>& previous;  // M^{b-1}
+  const float* previous;  // M^{b-1}
   std::size_t per_vertex, per_channel;
 };
 
@@ -580,7 +558,7 @@ void hit_radiance_rows(const BakeContext& ctx, BounceScratch& s, const BounceSou
     const meshes::Triangle& tri = ctx.mesh.triangles[hits[h].triangle];
     const float beta[3] = {1.f - hits[h].u - hits[h].v, hits[h].u, hits[h].v};
     for (int c = 0; c < 3; ++c) {
-      const float* corner = src.previous.data() + tri[c] * src.per_vertex + ch * src.per_channel;
+      const float* corner = src.previous + tri[c] * src.per_vertex + ch * src.per_channel;
       if (ctx.glossy) {
         s.rows.row(h).noalias() += beta[c] * (s.corner_y.col(3 * h + c).transpose() *
                                               Eigen::Map<const RowMatF>(corner, n, n));
@@ -617,82 +595,169 @@ void bounce_vertex(const BakeContext& ctx, BounceScratch& s, const BounceSource&
   }
 }
 
-// Interreflection: bounce b's transfer of every vertex from bounce b - 1's, summed into out.
-void bounce_passes(const BakeContext& ctx, const std::vector<HitBlock>& hit_blocks,
-                   TransferSet& out, ProgressReporter& progress) {
-  std::vector<float> previous = out.data;  // M^{b-1}; starts as the shadow pass
-  std::vector<float> current(out.data.size());
-  const BounceSource src{previous, out.floats_per_vertex(), out.floats_per_channel()};
-  BouncePool pool([&] { return BounceScratch(ctx.setup.n, ctx.setup.samples); });
-  for (int bounce = 1; bounce <= ctx.options.bounces; ++bounce) {
-    progress.start_pass(bounce);
-    tbb::parallel_for(std::uint64_t(0), ctx.chunks, [&](std::uint64_t chunk) {
-      BounceScratch& s = pool.local();
-      const HitBlock& block = hit_blocks[chunk];
-      const std::uint64_t begin = chunk * kChunk, end = std::min(ctx.vertex_count, begin + kChunk);
-      for (std::uint64_t p = begin; p < end; ++p) {
-        const std::uint32_t first = block.offsets[p - begin];
-        const int count = int(block.offsets[p - begin + 1] - first);
-        bounce_vertex(ctx, s, src, block.records.data() + first, count, p,
-                      current.data() + p * src.per_vertex);
-      }
-      progress.add(end - begin);
-    });
-    progress.finish_pass();
-    for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] += current[i];
-    previous.swap(current);
-  }
+// One interreflection pass over vertices [first, last): their bounce-b transfer, into dst,
+// from bounce b - 1's of every vertex (src).
+void bounce_range(const BakeContext& ctx, BouncePool& pool, const std::vector<HitBlock>& hit_blocks,
+                  const BounceSource& src, std::uint64_t first, std::uint64_t last, float* dst,
+                  ProgressReporter& progress) {
+  const std::uint64_t chunks = (last - first + kChunk - 1) / kChunk;
+  tbb::parallel_for(std::uint64_t(0), chunks, [&](std::uint64_t chunk) {
+    BounceScratch& s = pool.local();
+    const HitBlock& block = hit_blocks[chunk];
+    const std::uint64_t begin = first + chunk * kChunk, end = std::min(last, begin + kChunk);
+    for (std::uint64_t p = begin; p < end; ++p) {
+      const std::uint32_t at = block.offsets[p - begin];
+      const int count = int(block.offsets[p - begin + 1] - at);
+      bounce_vertex(ctx, s, src, block.records.data() + at, count, p,
+                    dst + (p - first) * src.per_vertex);
+    }
+    progress.add(end - begin);
+  });
 }
 
 }  // namespace
 
-TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stats) {
+namespace detail {
+
+struct BakeEngine::State {
+  State(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats& st)
+      : stats(st),
+        setup(make_setup(o, o.material.channels(), &st.seconds_brdf)),
+        scene(mesh),
+        ctx(mesh, o, setup, scene),
+        progress(o.progress, 1 + o.bounces, mesh.vertex_count()),
+        shadow_pool([this] { return ShadowScratch(ctx.options.order, setup.n, setup.samples); }),
+        bounce_pool([this] { return BounceScratch(setup.n, setup.samples); }) {}
+  BakeStats& stats;
+  Clock::time_point start = Clock::now();
+  Setup setup;
+  RayScene scene;
+  BakeContext ctx;
+  ProgressReporter progress;
+  ShadowPool shadow_pool;
+  BouncePool bounce_pool;
+  std::vector<std::uint8_t> flags;
+  std::uint64_t shaded = 0;  // vertices through the shadow pass (a shard's range)
+};
+
+namespace {
+const BakeOptions& checked(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats& st) {
   validate(o);
   if (!mesh.has_frames()) {
     throw std::invalid_argument("bake: the mesh has no vertex frames (call compute_frames)");
   }
-  const auto start_total = Clock::now();
-  BakeStats local_stats;
-  BakeStats& st = stats ? *stats : local_stats;
   st = BakeStats{};
+  return o;
+}
+}  // namespace
 
-  const int channels = o.material.channels();
-  const Setup setup = make_setup(o, channels, &st.seconds_brdf);
-  const RayScene scene(mesh);
-  BakeContext ctx{mesh, o, setup, scene};
-  ctx.channels = channels;
+BakeEngine::BakeEngine(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats& stats)
+    : state_(std::make_unique<State>(mesh, checked(mesh, o, stats), stats)) {
+  BakeContext& ctx = state_->ctx;
+  ctx.channels = o.material.channels();
   ctx.glossy = o.kind == TransferKind::kGlossy;
   ctx.offset = static_cast<float>(o.ray_offset * meshes::bounds(mesh).diagonal());
   ctx.faces = origin_faces(mesh, ctx.offset);
   ctx.vertex_count = mesh.vertex_count();
-  ctx.chunks = (ctx.vertex_count + kChunk - 1) / kChunk;
+  const TransferSet s = shape();
+  ctx.per_vertex = s.floats_per_vertex();
+  ctx.per_channel = s.floats_per_channel();
+  state_->flags.assign(ctx.vertex_count, 0);
+}
 
-  TransferSet out = empty_transfer(mesh, o, setup, channels);
-  std::vector<HitBlock> hit_blocks(o.bounces > 0 ? ctx.chunks : 0);
-  ProgressReporter progress(o.progress, 1 + o.bounces, ctx.vertex_count);
-  ShadowPool shadow_pool([&] { return ShadowScratch(o.order, setup.n, setup.samples); });
+BakeEngine::~BakeEngine() = default;
 
-  auto start_pass = Clock::now();
-  std::vector<std::uint8_t> flags(ctx.vertex_count);
-  shadow_pass(ctx, shadow_pool, hit_blocks, out, flags, progress);
-  st.seconds_shadow = seconds_since(start_pass);
-  for (std::uint64_t p = 0; p < ctx.vertex_count; ++p) {
-    if (flags[p] & kNearly) st.occluded_vertices.push_back(std::uint32_t(p));
-    if (flags[p] & kMoved) st.moved_origins.push_back(std::uint32_t(p));
+TransferSet BakeEngine::shape() const {
+  const BakeContext& ctx = state_->ctx;
+  const BakeOptions& o = ctx.options;
+  TransferSet out;
+  out.kind = o.kind;
+  out.order = o.order;
+  out.channels = o.material.channels();
+  out.vertex_count = ctx.mesh.vertex_count();
+  out.samples = state_->setup.samples;
+  out.bounces = o.bounces;
+  out.seed = o.seed;
+  out.material = o.material;
+  out.mesh_hash = meshes::content_hash(ctx.mesh);
+  return out;
+}
+
+std::size_t BakeEngine::floats_per_vertex() const {
+  return state_->ctx.per_vertex;
+}
+std::uint64_t BakeEngine::vertex_count() const {
+  return state_->ctx.vertex_count;
+}
+void BakeEngine::start_pass(int pass) {
+  state_->progress.start_pass(pass);
+}
+void BakeEngine::finish_pass() {
+  state_->progress.finish_pass();
+}
+
+void BakeEngine::shadow(std::uint64_t begin, std::uint64_t end, float* dst,
+                        std::vector<HitBlock>* hits) {
+  const auto start = Clock::now();
+  State& st = *state_;
+  shadow_range(st.ctx, st.shadow_pool, begin, end, dst, hits, st.flags, st.progress);
+  st.shaded += end - begin;
+  st.stats.seconds_shadow += seconds_since(start);
+}
+
+void BakeEngine::bounce(std::uint64_t begin, std::uint64_t end, const std::vector<HitBlock>& hits,
+                        const float* previous, float* dst) {
+  const auto start = Clock::now();
+  State& st = *state_;
+  const BounceSource src{previous, st.ctx.per_vertex, st.ctx.per_channel};
+  bounce_range(st.ctx, st.bounce_pool, hits, src, begin, end, dst, st.progress);
+  st.stats.seconds_bounces += seconds_since(start);
+}
+
+void BakeEngine::finish() {
+  State& state = *state_;
+  BakeStats& st = state.stats;
+  for (std::uint64_t p = 0; p < state.flags.size(); ++p) {
+    if (state.flags[p] & kNearly) st.occluded_vertices.push_back(std::uint32_t(p));
+    if (state.flags[p] & kMoved) st.moved_origins.push_back(std::uint32_t(p));
   }
-  start_pass = Clock::now();
-  if (o.bounces > 0) bounce_passes(ctx, hit_blocks, out, progress);
-  st.seconds_bounces = seconds_since(start_pass);
-
-  for (const ShadowScratch& s : shadow_pool) {
+  st.rays_shadow = st.rays_bounce = 0;
+  double occluded = 0;
+  for (const ShadowScratch& s : state.shadow_pool) {
     st.rays_shadow += s.rays_shadow;
     st.rays_bounce += s.rays_bounce;
-    st.occluded_fraction += double(s.occluded_count);
+    occluded += double(s.occluded_count);
   }
   // Over the rays each vertex kept: a moved vertex's first, discarded trace is not counted.
-  const double kept = double(ctx.vertex_count) * setup.samples;
-  st.occluded_fraction = kept > 0 ? st.occluded_fraction / kept : 0.0;
-  st.seconds_total = seconds_since(start_total);
+  const double kept = double(state.shaded) * state.setup.samples;
+  st.occluded_fraction = kept > 0 ? occluded / kept : 0.0;
+  st.seconds_total = seconds_since(state.start);
+}
+
+}  // namespace detail
+
+TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stats) {
+  BakeStats local_stats;
+  detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
+  TransferSet out = engine.shape();
+  const std::uint64_t v = engine.vertex_count();
+  out.data.assign(v * engine.floats_per_vertex(), 0.f);
+  std::vector<HitBlock> hits;
+  engine.start_pass(0);
+  engine.shadow(0, v, out.data.data(), o.bounces > 0 ? &hits : nullptr);
+  engine.finish_pass();
+  if (o.bounces > 0) {
+    std::vector<float> previous = out.data;  // M^{b-1}; starts as the shadow pass
+    std::vector<float> current(out.data.size());
+    for (int bounce = 1; bounce <= o.bounces; ++bounce) {
+      engine.start_pass(bounce);
+      engine.bounce(0, v, hits, previous.data(), current.data());
+      engine.finish_pass();
+      for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] += current[i];
+      previous.swap(current);
+    }
+  }
+  engine.finish();
   return out;
 }
 

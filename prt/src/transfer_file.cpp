@@ -24,6 +24,9 @@
 #include <system_error>
 #include <type_traits>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 namespace prt {
 namespace {
 
@@ -182,7 +185,24 @@ std::size_t first_non_finite(const std::vector<float>& data) {
   return data.size();
 }
 
-Header encode_header(const TransferSet& set, std::uint64_t payload_checksum) {
+// Every field but the payload: the writer must not copy a whole bake.
+TransferSet without_payload(const TransferSet& set) {
+  TransferSet s;
+  s.kind = set.kind;
+  s.order = set.order;
+  s.channels = set.channels;
+  s.vertex_count = set.vertex_count;
+  s.samples = set.samples;
+  s.bounces = set.bounces;
+  s.seed = set.seed;
+  s.material = set.material;
+  s.mesh_hash = set.mesh_hash;
+  s.payload_checksum = set.payload_checksum;
+  return s;
+}
+
+Header encode_header(const TransferSet& set, std::uint64_t payload_floats,
+                     std::uint64_t payload_checksum) {
   Header h = common::begin_header(kFormat);  // zero: padding and reserved fields
   common::put_field<std::uint32_t>(h, kOffKind, static_cast<std::uint32_t>(set.kind));
   common::put_field<std::uint32_t>(h, kOffOrder, static_cast<std::uint32_t>(set.order));
@@ -200,23 +220,18 @@ Header encode_header(const TransferSet& set, std::uint64_t payload_checksum) {
   common::put_field<float>(h, kOffExponent, set.material.exponent);
   common::put_field<float>(h, kOffRoughness, set.material.roughness);
   common::put_field<float>(h, kOffF0, set.material.f0);
-  common::put_field<std::uint64_t>(h, kOffPayloadFloats, set.data.size());
+  common::put_field<std::uint64_t>(h, kOffPayloadFloats, payload_floats);
   common::put_field<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum);
   common::seal_header(h);
   return h;
 }
 
-TransferSet read(const fs::path& path, bool with_payload) {
-  const std::string name = path.string();
+// The header's fields, checked: ranges, reserved bytes, payload size, header checksum.
+// `payload_floats` gets the payload size it records.
+TransferSet decode(const Header& h, const std::string& name, std::uint64_t* payload_floats_out) {
   const auto fail = [&](const std::string& problem) {
     return TransferFileError(name + ": " + problem);
   };
-  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
-  if (!opened.problem.empty()) throw fail(opened.problem);
-  std::ifstream& in = opened.stream;
-  const std::uintmax_t size = opened.size;
-  const Header& h = opened.header;
-
   Fields f;
   f.kind = common::get_field<std::uint32_t>(h, kOffKind);
   f.order = common::get_field<std::uint32_t>(h, kOffOrder);
@@ -268,6 +283,22 @@ TransferSet read(const fs::path& path, bool with_payload) {
   }
   if (const std::string problem = common::header_checksum_problem(h, kFormat); !problem.empty())
     throw fail(problem);
+  *payload_floats_out = payload_floats;
+  return set;
+}
+
+TransferSet read(const fs::path& path, bool with_payload) {
+  const std::string name = path.string();
+  const auto fail = [&](const std::string& problem) {
+    return TransferFileError(name + ": " + problem);
+  };
+  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
+  if (!opened.problem.empty()) throw fail(opened.problem);
+  std::ifstream& in = opened.stream;
+  const std::uintmax_t size = opened.size;
+  const Header& h = opened.header;
+  std::uint64_t payload_floats = 0;
+  TransferSet set = decode(h, name, &payload_floats);
   std::uint64_t expected_size = 0;
   if (__builtin_mul_overflow(payload_floats, std::uint64_t(4), &expected_size) ||
       __builtin_add_overflow(expected_size, std::uint64_t(kHeaderBytes), &expected_size)) {
@@ -306,7 +337,7 @@ void write_transfer(const fs::path& path, const TransferSet& set) {
   const auto refuse = [&](const std::string& problem) {
     return std::invalid_argument(path.string() + ": cannot write the transfer set: " + problem);
   };
-  // Refuse what read_transfer would refuse, so that every written file can be read back.
+  // Refuse what read_transfer would refuse before touching the directory.
   if (const std::string problem = field_problem(fields_of(set)); !problem.empty())
     throw refuse(problem);
   std::uint64_t expected_floats = 0;
@@ -319,13 +350,86 @@ void write_transfer(const fs::path& path, const TransferSet& set) {
   }
   if (const std::size_t i = first_non_finite(set.data); i != set.data.size())
     throw refuse("non-finite value " + num(set.data[i]) + " at " + locate(set, i));
+  TransferFileWriter writer(path, set);
+  writer.append(set.data.data(), set.data.size());
+  writer.commit();
+}
 
-  const std::size_t payload_bytes = set.data.size() * sizeof(float);
-  const Header h = encode_header(set, common::fnv1a(set.data.data(), payload_bytes));
-  common::AtomicFile file(path);
-  file.write(h.data(), h.size());
-  if (payload_bytes > 0) file.write(set.data.data(), payload_bytes);
-  file.commit();
+// The header goes first as zeros and is written over once the payload checksum is known:
+// the payload streams through in vertex order, and FNV-1a continues across blocks, so the
+// file is the same bytes write_transfer produces from the whole set at once.
+TransferFileWriter::TransferFileWriter(const fs::path& path, const TransferSet& shape)
+    : shape_(without_payload(shape)), hash_(common::kFnvOffset) {
+  const auto refuse = [&](const std::string& problem) {
+    return std::invalid_argument(path.string() + ": cannot write the transfer set: " + problem);
+  };
+  // Refuse what read_transfer would refuse, so that every written file can be read back.
+  if (const std::string problem = field_problem(fields_of(shape_)); !problem.empty())
+    throw refuse(problem);
+  if (!payload_floats_of(shape_.vertex_count, shape_.floats_per_vertex(), &expected_)) {
+    throw refuse("vertex count " + std::to_string(shape_.vertex_count) + " is too large");
+  }
+  file_ = std::make_unique<common::AtomicFile>(path);
+  const Header zeros{};
+  file_->write(zeros.data(), zeros.size());
+}
+
+TransferFileWriter::~TransferFileWriter() = default;
+
+void TransferFileWriter::append(const float* data, std::size_t floats) {
+  if (floats > expected_ - written_) {
+    throw std::invalid_argument(file_->target().string() +
+                                ": cannot write the transfer set: more than " +
+                                std::to_string(expected_) + " floats appended");
+  }
+  for (std::size_t i = 0; i < floats; ++i) {
+    if (!std::isfinite(data[i])) {
+      throw std::invalid_argument(file_->target().string() +
+                                  ": cannot write the transfer set: non-finite value " +
+                                  num(data[i]) + " at " + locate(shape_, written_ + i));
+    }
+  }
+  hash_ = common::fnv1a(data, floats * sizeof(float), hash_);
+  if (floats > 0) file_->write(data, floats * sizeof(float));
+  written_ += floats;
+}
+
+void TransferFileWriter::commit() {
+  if (written_ != expected_) {
+    throw std::invalid_argument(file_->target().string() +
+                                ": cannot write the transfer set: " + std::to_string(written_) +
+                                " of " + std::to_string(expected_) + " floats were appended");
+  }
+  const Header h = encode_header(shape_, expected_, hash_);
+  const int fd = ::open(file_->temporary().c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0 || ::pwrite(fd, h.data(), h.size(), 0) != static_cast<ssize_t>(h.size())) {
+    const std::string why = std::strerror(errno);
+    if (fd >= 0) ::close(fd);
+    throw common::IoError(file_->target().string() + ": cannot write the header (" + why + ")");
+  }
+  ::close(fd);
+  file_->commit();  // its fsync covers the header written through the second descriptor
+}
+
+std::array<unsigned char, kTransferHeaderBytes> encode_transfer_header(
+    const TransferSet& shape, std::uint64_t payload_checksum) {
+  std::uint64_t floats = 0;
+  if (const std::string problem = field_problem(fields_of(shape)); !problem.empty())
+    throw std::invalid_argument("cannot encode the transfer header: " + problem);
+  if (!payload_floats_of(shape.vertex_count, shape.floats_per_vertex(), &floats))
+    throw std::invalid_argument("cannot encode the transfer header: too many vertices");
+  return encode_header(shape, floats, payload_checksum);
+}
+
+TransferSet decode_transfer_header(const std::array<unsigned char, kTransferHeaderBytes>& header,
+                                   const std::string& name) {
+  if (std::memcmp(header.data(), kMagic.data(), kMagic.size()) != 0 ||
+      common::get_field<std::uint32_t>(header, 8) != kTransferFileVersion) {
+    throw TransferFileError(name + ": the transfer header inside is not a version " +
+                            std::to_string(kTransferFileVersion) + " .prtx header; " + kRebake);
+  }
+  std::uint64_t floats = 0;
+  return decode(header, name, &floats);
 }
 
 TransferSet read_transfer(const fs::path& path) {

@@ -38,6 +38,7 @@
 #include "prt/transfer.h"
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -102,5 +103,27 @@ struct BakeStats {
 // The mesh must have frames (meshes::compute_frames). Throws std::invalid_argument for bad
 // options and RayError if Embree fails.
 TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& options, BakeStats* stats = nullptr);
+
+// The same bake written straight to a .prtx at `path`, `block_vertices` vertices at a time
+// (0: default_block_vertices), so memory holds a block, the mesh and the ray scene but never
+// the whole payload. The file is byte for byte write_transfer(path, bake(mesh, options)).
+// With bounces, the shadow pass and its front hits go to scratch files beside `path` and
+// each bounce reads the previous pass through a memory map (docs/ARCHITECTURE.md, "Scale").
+// Atomic: nothing is left at `path` (or beside it) unless the bake completes. Returns the
+// header fields (data empty).
+TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& options,
+                         const std::filesystem::path& path, std::uint64_t block_vertices = 0,
+                         BakeStats* stats = nullptr);
+
+// Shard `index` of `count` of that bake: its vertex range (prt/transfer_shard.h) into a
+// shard file for prt::merge_shards. Bounces need every vertex's previous pass, so a shard
+// bake refuses bounces > 0 (std::invalid_argument naming --shard).
+TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& options,
+                               const std::filesystem::path& path, std::uint32_t index,
+                               std::uint32_t count, std::uint64_t block_vertices = 0,
+                               BakeStats* stats = nullptr);
+
+// Vertices per block holding about 64 MiB of transfer (a multiple of 64, at least 64).
+std::uint64_t default_block_vertices(std::size_t floats_per_vertex);
 
 }  // namespace prt

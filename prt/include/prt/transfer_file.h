@@ -5,11 +5,15 @@
 // payload, so a truncated or damaged file is detected before it is used.
 #pragma once
 
+#include "common/atomic_file.h"
 #include "prt/transfer.h"
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
+#include <string>
 
 namespace prt {
 
@@ -22,6 +26,39 @@ class TransferFileError : public std::runtime_error {
 
 // Written atomically (common/atomic_file.h): a crash leaves the old file or none.
 void write_transfer(const std::filesystem::path& path, const TransferSet& set);
+
+// Writes a transfer file whose payload arrives in vertex order, block by block, so a bake
+// never holds the whole payload: the bytes equal write_transfer's for the same values.
+// Atomic like write_transfer; nothing appears at `path` unless commit() succeeds.
+class TransferFileWriter {
+ public:
+  // `shape` gives every header field; its data is ignored. Throws std::invalid_argument for
+  // fields read_transfer would refuse, common::IoError when the directory is not writable.
+  TransferFileWriter(const std::filesystem::path& path, const TransferSet& shape);
+  ~TransferFileWriter();
+  TransferFileWriter(const TransferFileWriter&) = delete;
+  TransferFileWriter& operator=(const TransferFileWriter&) = delete;
+
+  // The next `floats` values of the payload; throws on a non-finite value or an overrun.
+  void append(const float* data, std::size_t floats);
+  // Throws unless exactly the payload's floats were appended.
+  void commit();
+  std::uint64_t expected_floats() const { return expected_; }
+
+ private:
+  TransferSet shape_;
+  std::unique_ptr<common::AtomicFile> file_;
+  std::uint64_t expected_ = 0, written_ = 0, hash_ = 0;
+};
+
+// The 128-byte header alone, for containers that carry one (transfer shards,
+// prt/transfer_shard.h). encode throws std::invalid_argument for fields out of range;
+// decode checks it as read_transfer does and throws TransferFileError naming `name`.
+inline constexpr std::size_t kTransferHeaderBytes = 128;
+std::array<unsigned char, kTransferHeaderBytes> encode_transfer_header(
+    const TransferSet& shape, std::uint64_t payload_checksum);
+TransferSet decode_transfer_header(const std::array<unsigned char, kTransferHeaderBytes>& header,
+                                   const std::string& name);
 
 // Reads and validates everything: magic, version, header fields in range, file size equal
 // to header + payload, payload checksum, finite values. Each failure is a TransferFileError

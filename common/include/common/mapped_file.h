@@ -1,0 +1,38 @@
+// common/mapped_file.h: a read-only memory map of a whole file, for inputs larger than the
+// memory a process should hold (a streaming bake's previous pass, a .prtx being compressed).
+// Pages come from the page cache on first touch; release() drops this process's mappings of
+// them so its resident set stays bounded by what it touched since, while the kernel keeps
+// the pages cached for a cheap re-fault.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+
+namespace common {
+
+class MappedFile {
+ public:
+  // Throws IoError (common/atomic_file.h) naming the path when it cannot be opened or mapped.
+  explicit MappedFile(const std::filesystem::path& path);
+  ~MappedFile();
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+
+  const unsigned char* data() const { return data_; }
+  std::size_t size() const { return size_; }
+  // Drops the resident pages of [offset, offset + bytes) from this mapping (whole pages
+  // inside the range); their contents stay readable.
+  void release(std::size_t offset, std::size_t bytes) const;
+  void release() const { release(0, size_); }
+
+ private:
+  const unsigned char* data_ = nullptr;
+  std::size_t size_ = 0;
+};
+
+// Reads exactly `bytes` at `offset` of the open descriptor `fd`; throws IoError naming
+// `what` on a short read or an error.
+void read_exact(int fd, void* out, std::size_t bytes, std::uint64_t offset, const char* what);
+
+}  // namespace common

@@ -1,0 +1,221 @@
+// The streaming bake (prt/bake.h, bake_to_file): the passes of bake() over blocks of
+// vertices, each block written out as it finishes. Design and measurements:
+// docs/ARCHITECTURE.md, "Scale".
+#include "prt/bake.h"
+
+#include "bake_engine.h"
+#include "common/atomic_file.h"
+#include "common/mapped_file.h"
+#include "prt/transfer_file.h"
+#include "prt/transfer_shard.h"
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+namespace prt {
+namespace {
+
+namespace fs = std::filesystem;
+using detail::HitBlock;
+using detail::HitRecord;
+using detail::kChunk;
+
+// A pass's intermediate data on disk: an AtomicFile beside the output that is never
+// committed, so it vanishes with the bake (or is swept after a crash), read back through
+// its own descriptor or a map.
+class Scratch {
+ public:
+  explicit Scratch(const fs::path& target) : file_(target) {
+    fd_ = ::open(file_.temporary().c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd_ < 0) throw common::IoError(file_.temporary().string() + ": cannot reopen to read");
+  }
+  ~Scratch() { ::close(fd_); }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+
+  std::uint64_t write(const void* data, std::size_t bytes) {
+    const std::uint64_t at = size_;
+    if (bytes > 0) file_.write(data, bytes);
+    size_ += bytes;
+    return at;
+  }
+  void read(void* out, std::size_t bytes, std::uint64_t offset) const {
+    if (bytes > 0) common::read_exact(fd_, out, bytes, offset, file_.temporary().c_str());
+  }
+  const fs::path& path() const { return file_.temporary(); }
+
+ private:
+  common::AtomicFile file_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
+
+// The shadow pass's front hits, kept on disk for every bounce: per chunk, its offsets in
+// memory (4 bytes a vertex) and where its records start in the scratch file.
+class HitStore {
+ public:
+  explicit HitStore(const fs::path& target) : file_(target) {}
+  void store(const std::vector<HitBlock>& blocks) {
+    for (const HitBlock& b : blocks) {
+      at_.push_back(file_.write(b.records.data(), b.records.size() * sizeof(HitRecord)));
+      offsets_.push_back(b.offsets);
+    }
+  }
+  // The chunks [first_chunk, first_chunk + count) as shadow() produced them.
+  void load(std::size_t first_chunk, std::size_t count, std::vector<HitBlock>& out) const {
+    out.resize(count);
+    for (std::size_t c = 0; c < count; ++c) {
+      const std::vector<std::uint32_t>& offsets = offsets_[first_chunk + c];
+      out[c].offsets = offsets;
+      out[c].records.resize(offsets.back());
+      file_.read(out[c].records.data(), out[c].records.size() * sizeof(HitRecord),
+                 at_[first_chunk + c]);
+    }
+  }
+
+ private:
+  Scratch file_;
+  std::vector<std::uint64_t> at_;
+  std::vector<std::vector<std::uint32_t>> offsets_;
+};
+
+fs::path scratch_target(const fs::path& path, const std::string& what) {
+  return path.parent_path() / (path.filename().string() + "." + what);
+}
+
+// The bounce passes: bounce b reads M^{b-1} of every vertex through a map of the previous
+// pass's scratch file, and the running sum S^{b-1} block by block, and writes
+// S^b = S^{b-1} + M^b (to the output on the last bounce) and M^b (for the next bounce).
+void stream_bounces(detail::BakeEngine& engine, int bounces, std::uint64_t block,
+                    const fs::path& path, const HitStore& hits,
+                    std::shared_ptr<Scratch> previous_pass, TransferFileWriter& writer) {
+  const std::uint64_t v = engine.vertex_count();
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  std::shared_ptr<Scratch> previous_sum = previous_pass;  // S^0 = M^0
+  std::vector<float> current(block * per_vertex), sum(block * per_vertex);
+  std::vector<HitBlock> hit_blocks;
+  for (int b = 1; b <= bounces; ++b) {
+    const bool last = b == bounces;
+    std::shared_ptr<Scratch> pass, running;
+    if (!last) {
+      pass = std::make_shared<Scratch>(scratch_target(path, "bounce"));
+      running = std::make_shared<Scratch>(scratch_target(path, "sum"));
+    }
+    const common::MappedFile map(previous_pass->path());
+    const auto* m_previous = reinterpret_cast<const float*>(map.data());
+    engine.start_pass(b);
+    for (std::uint64_t begin = 0; begin < v; begin += block) {
+      const std::uint64_t end = std::min(v, begin + block), n = (end - begin) * per_vertex;
+      // Every block but the last has `block` vertices, so the same number of chunks.
+      const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
+      hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
+      engine.bounce(begin, end, hit_blocks, m_previous, current.data());
+      previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
+      for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
+      if (last) {
+        writer.append(sum.data(), n);
+      } else {
+        pass->write(current.data(), n * sizeof(float));
+        running->write(sum.data(), n * sizeof(float));
+      }
+      // What this block touched of M^{b-1} leaves the resident set; the next block's hits
+      // fault in their own neighbourhood from the page cache.
+      map.release();
+    }
+    engine.finish_pass();
+    previous_pass = pass;
+    previous_sum = running;
+  }
+}
+
+}  // namespace
+
+std::uint64_t default_block_vertices(std::size_t floats_per_vertex) {
+  // ~64 MiB of transfer per block buffer: large enough that a block keeps every thread busy
+  // and amortises a re-fault of its neighbourhood, small against any mesh worth streaming.
+  const std::uint64_t bytes = std::uint64_t(64) << 20;
+  const std::uint64_t v = bytes / (floats_per_vertex * sizeof(float));
+  return std::max<std::uint64_t>(kChunk, v / kChunk * kChunk);
+}
+
+TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const fs::path& path,
+                         std::uint64_t block_vertices, BakeStats* stats) {
+  BakeStats local_stats;
+  detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
+  const TransferSet shape = engine.shape();
+  const std::uint64_t v = engine.vertex_count();
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::uint64_t block =
+      block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex);
+  TransferFileWriter writer(path, shape);
+  std::vector<float> buffer(std::min(v, block) * per_vertex);
+  std::shared_ptr<Scratch> shadow_pass;
+  std::unique_ptr<HitStore> hits;
+  if (o.bounces > 0) {
+    shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
+    hits = std::make_unique<HitStore>(scratch_target(path, "hits"));
+  }
+  std::vector<HitBlock> hit_blocks;
+  engine.start_pass(0);
+  for (std::uint64_t begin = 0; begin < v; begin += block) {
+    const std::uint64_t end = std::min(v, begin + block), n = (end - begin) * per_vertex;
+    engine.shadow(begin, end, buffer.data(), hits ? &hit_blocks : nullptr);
+    if (hits) {
+      shadow_pass->write(buffer.data(), n * sizeof(float));
+      hits->store(hit_blocks);
+    } else {
+      writer.append(buffer.data(), n);
+    }
+  }
+  engine.finish_pass();
+  buffer = {};
+  if (o.bounces > 0) {
+    stream_bounces(engine, o.bounces, std::min(v, block), path, *hits, shadow_pass, writer);
+  }
+  writer.commit();
+  engine.finish();
+  return shape;
+}
+
+TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const fs::path& path,
+                               std::uint32_t index, std::uint32_t count,
+                               std::uint64_t block_vertices, BakeStats* stats) {
+  if (count == 0 || index >= count) {
+    throw std::invalid_argument("--shard " + std::to_string(index) + "/" + std::to_string(count) +
+                                ": k/n needs 0 <= k < n");
+  }
+  if (o.bounces > 0) {
+    // A bounce reads the previous pass at every vertex its rays hit, anywhere on the mesh,
+    // so a vertex range alone cannot compute it (docs/ARCHITECTURE.md, "Scale").
+    throw std::invalid_argument(
+        "--shard needs --bounces 0: an interreflection pass reads every vertex's previous "
+        "pass; bake with bounces in one process (prtr bake streams, so memory stays bounded)");
+  }
+  BakeStats local_stats;
+  detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
+  const TransferSet shape = engine.shape();
+  const ShardRange range = shard_range(engine.vertex_count(), index, count);
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::uint64_t block =
+      block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex);
+  TransferShardWriter writer(path, shape, range);
+  std::vector<float> buffer(std::min(range.end - range.first, block) * per_vertex);
+  engine.start_pass(0);
+  for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
+    const std::uint64_t end = std::min(range.end, begin + block);
+    engine.shadow(begin, end, buffer.data(), nullptr);
+    writer.append(buffer.data(), (end - begin) * per_vertex);
+  }
+  engine.finish_pass();
+  writer.commit();
+  engine.finish();
+  return shape;
+}
+
+}  // namespace prt

@@ -1,0 +1,182 @@
+// The streaming bake (prt::bake_to_file) against the whole-mesh bake written by
+// write_transfer: the same bytes, whatever the block size, with and without bounces.
+#include "prt/bake.h"
+#include "prt/transfer_file.h"
+#include "prt/transfer_shard.h"
+
+#include "meshes/procedural.h"
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+prt::BakeOptions small_options(prt::TransferKind kind, int bounces) {
+  prt::BakeOptions o;
+  o.kind = kind;
+  o.order = 3;
+  o.samples = 64;
+  o.bounces = bounces;
+  o.seed = 7;
+  o.material.kind = prt::MaterialKind::kPhong;
+  o.material.albedo = Eigen::Vector3f(0.6f, 0.4f, 0.2f);  // three channels
+  o.material.specular = 0.3f;
+  return o;
+}
+
+// The torus's inner ring sees itself, so bounces read transfer far from the vertex's block.
+meshes::Mesh torus() {
+  return meshes::make_torus(1.f, 0.4f, 24, 12);
+}
+
+std::size_t files_in(const fs::path& dir) {
+  std::size_t n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) n += e.is_regular_file();
+  return n;
+}
+
+void expect_same_file(const meshes::Mesh& mesh, const prt::BakeOptions& o, std::uint64_t block,
+                      const std::string& name) {
+  // A directory per case: ctest runs cases in parallel, and this one counts its files.
+  const fs::path whole = test_support::scratch("bake_stream_" + name, "whole.prtx");
+  const fs::path streamed = test_support::scratch("bake_stream_" + name, "streamed.prtx");
+  prt::BakeStats whole_stats, stream_stats;
+  prt::write_transfer(whole, prt::bake(mesh, o, &whole_stats));
+  const std::size_t before = files_in(streamed.parent_path());
+  const prt::TransferSet shape = prt::bake_to_file(mesh, o, streamed, block, &stream_stats);
+  EXPECT_EQ(shape.vertex_count, mesh.vertex_count());
+  EXPECT_TRUE(shape.data.empty());
+  const std::string a = test_support::slurp(whole), b = test_support::slurp(streamed);
+  ASSERT_EQ(a.size(), b.size()) << name;
+  EXPECT_TRUE(a == b) << name << ": block " << block << " differs from the whole-mesh bake";
+  // Only the output appeared: the scratch passes are gone.
+  EXPECT_EQ(files_in(streamed.parent_path()), before + 1) << name;
+  EXPECT_EQ(stream_stats.rays_shadow, whole_stats.rays_shadow);
+  EXPECT_EQ(stream_stats.rays_bounce, whole_stats.rays_bounce);
+  EXPECT_EQ(stream_stats.occluded_vertices, whole_stats.occluded_vertices);
+  fs::remove(streamed);
+}
+
+TEST(StreamingBake, GlossyOneBounceEqualsTheWholeBakeForEveryBlockSize) {
+  const meshes::Mesh mesh = torus();
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 1);
+  for (std::uint64_t block :
+       {std::uint64_t(1), std::uint64_t(37), std::uint64_t(64), std::uint64_t(100000)}) {
+    expect_same_file(mesh, o, block, "glossy1_" + std::to_string(block));
+  }
+}
+
+TEST(StreamingBake, DiffuseTwoBouncesEqualTheWholeBake) {
+  // Two bounces exercise the running sum kept on disk between passes.
+  expect_same_file(torus(), small_options(prt::TransferKind::kDiffuse, 2), 37, "diffuse2");
+}
+
+TEST(StreamingBake, NoBouncesEqualsTheWholeBake) {
+  expect_same_file(torus(), small_options(prt::TransferKind::kGlossy, 0), 50, "glossy0");
+}
+
+TEST(StreamingBake, TheFileReadsBackAndAFailedBakeLeavesNothing) {
+  const fs::path dir = test_support::scratch("bake_stream_fail", "dir");
+  fs::create_directories(dir);
+  prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 1);
+  o.order = 0;  // invalid: refused before anything is written
+  EXPECT_THROW(prt::bake_to_file(torus(), o, dir / "bad.prtx", 16), std::invalid_argument);
+  EXPECT_EQ(files_in(dir), 0u);
+}
+
+// Bakes shards k/n of `o` (block 16) into the scratch directory; returns their paths.
+std::vector<fs::path> bake_shards(const meshes::Mesh& mesh, const prt::BakeOptions& o,
+                                  std::uint32_t n, const std::string& name) {
+  std::vector<fs::path> paths;
+  for (std::uint32_t k = 0; k < n; ++k) {
+    paths.push_back(test_support::scratch("bake_stream", name + "_" + std::to_string(k)));
+    prt::bake_shard_to_file(mesh, o, paths.back(), k, n, 16);
+  }
+  return paths;
+}
+
+// The message of the TransferFileError merge_shards throws, or "" if it merged.
+std::string merge_error(const std::vector<fs::path>& shards, const fs::path& out) {
+  try {
+    prt::merge_shards(shards, out);
+  } catch (const prt::TransferFileError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Shards, MergedShardsEqualTheSingleBakeInAnyOrder) {
+  const meshes::Mesh mesh = torus();
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 0);
+  const fs::path single = test_support::scratch("bake_stream", "single.prtx");
+  prt::write_transfer(single, prt::bake(mesh, o));
+  // 5 shards of 288 vertices: uneven ranges (57 and 58 vertices), blocks of 16 inside them.
+  std::vector<fs::path> shards = bake_shards(mesh, o, 5, "five");
+  std::swap(shards[0], shards[3]);
+  const fs::path merged = test_support::scratch("bake_stream", "merged.prtx");
+  ASSERT_EQ(merge_error(shards, merged), "");
+  EXPECT_TRUE(test_support::slurp(single) == test_support::slurp(merged));
+  // More shards than some ranges can fill: empty shards merge too.
+  const meshes::Mesh tiny = meshes::make_plane(1.f, 1);  // 4 vertices
+  const fs::path tiny_single = test_support::scratch("bake_stream", "tiny.prtx");
+  prt::write_transfer(tiny_single, prt::bake(tiny, o));
+  ASSERT_EQ(merge_error(bake_shards(tiny, o, 6, "tiny"), merged), "");
+  EXPECT_TRUE(test_support::slurp(tiny_single) == test_support::slurp(merged));
+}
+
+TEST(Shards, MergeRefusesShardsThatDoNotBelongTogether) {
+  const meshes::Mesh mesh = torus();
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 0);
+  const std::vector<fs::path> good = bake_shards(mesh, o, 3, "good");
+  const fs::path out = test_support::scratch("bake_stream", "refused.prtx");
+  fs::remove(out);
+
+  prt::BakeOptions other_seed = o;
+  other_seed.seed = 8;
+  const std::vector<fs::path> seed8 = bake_shards(mesh, other_seed, 3, "seed8");
+  std::string e = merge_error({good[0], seed8[1], good[2]}, out);
+  EXPECT_NE(e.find("different bakes"), std::string::npos) << e;
+  EXPECT_NE(e.find("seed"), std::string::npos) << e;
+
+  const std::vector<fs::path> other_mesh =
+      bake_shards(meshes::make_torus(1.f, 0.3f, 24, 12), o, 3, "mesh");
+  e = merge_error({good[0], other_mesh[1], good[2]}, out);
+  EXPECT_NE(e.find("mesh hash"), std::string::npos) << e;
+
+  e = merge_error({good[0], good[2]}, out);
+  EXPECT_NE(e.find("shard 1/3 is missing"), std::string::npos) << e;
+  e = merge_error({good[0], good[1], good[1], good[2]}, out);
+  EXPECT_NE(e.find("shard 1/3 is given twice"), std::string::npos) << e;
+
+  const std::vector<fs::path> four = bake_shards(mesh, o, 4, "four");
+  e = merge_error({good[0], good[1], four[3]}, out);
+  EXPECT_NE(e.find("same --shard n"), std::string::npos) << e;
+
+  // A damaged payload byte is caught by the shard's checksum, and nothing is written.
+  std::string bytes = test_support::slurp(good[1]);
+  bytes[bytes.size() - 3] ^= 0x40;
+  const fs::path damaged = test_support::scratch("bake_stream", "damaged_shard");
+  std::ofstream(damaged, std::ios::binary) << bytes;
+  e = merge_error({good[0], damaged, good[2]}, out);
+  EXPECT_NE(e.find("damaged"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Shards, BouncesAreRefusedByName) {
+  try {
+    prt::bake_shard_to_file(torus(), small_options(prt::TransferKind::kGlossy, 1),
+                            test_support::scratch("bake_stream", "bounce_shard"), 0, 2);
+    FAIL() << "a shard with bounces was baked";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--bounces 0"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
