@@ -109,6 +109,24 @@ def check_rejections(server):
     check("still serving after garbage", status == 200)
 
 
+def check_usage(prtr, mesh, probe, cache):
+    base = [prtr, "view", mesh, "--probe", probe, "--cache", cache, "-q"] + vs.SMALL_BAKE
+    r = subprocess.run(base + ["--strategy", "bogus"], capture_output=True, text=True, timeout=60)
+    check("--strategy bogus: exit 2 naming it", r.returncode == 2 and "--strategy" in r.stderr,
+          r.stderr)
+    r = subprocess.run(base + ["--mode", "multipass", "--register-budget", "1"],
+                       capture_output=True, text=True, timeout=120)
+    check("--register-budget 1: exit 2 naming it",
+          r.returncode == 2 and "--register-budget" in r.stderr, r.stderr)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        r = subprocess.run(base + ["--port", str(port)], capture_output=True, text=True,
+                           timeout=120)
+    check("a port in use: exit 1 naming it", r.returncode == 1 and str(port) in r.stderr, r.stderr)
+
+
 def main():
     prtr, tmp = sys.argv[1], sys.argv[2]
     shutil.rmtree(tmp, ignore_errors=True)
@@ -136,6 +154,7 @@ def main():
     check("SIGTERM exits 0", code == 0, "(exit %s; stderr %s)" % (code, server.proc.stderr.read()))
     check("prints how many requests it served",
           any("stopped after" in line for line in server.lines), "".join(server.lines))
+    check_usage(prtr, mesh, probe, cache)
     leftovers = [f for f in os.listdir(cache) if "tmp" in f]
     check("no temporary files in the cache", not leftovers, str(leftovers))
     print("view_cli_test: %d passed, %d failed" % (passed, failed))

@@ -72,12 +72,14 @@ bool is_probe_file(const fs::path& p) {
 
 // The probes the page may choose: the *.exr/*.hdr beside --probe, by name, --probe among them.
 // Only this list is ever opened; requests name an index into it.
-std::vector<fs::path> scan_probes(const fs::path& probe, int& index) {
+std::vector<fs::path> scan_probes(const fs::path& given, int& index) {
+  const fs::path probe = given.lexically_normal();
   std::vector<fs::path> found;
   std::error_code ec;
   const fs::path dir = probe.has_parent_path() ? probe.parent_path() : fs::path(".");
   for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (entry.is_regular_file(ec) && is_probe_file(entry.path())) found.push_back(entry.path());
+    if (entry.is_regular_file(ec) && is_probe_file(entry.path()))
+      found.push_back(entry.path().lexically_normal());
   if (std::find(found.begin(), found.end(), probe) == found.end()) found.push_back(probe);
   std::sort(found.begin(), found.end());
   index = int(std::find(found.begin(), found.end(), probe) - found.begin());
