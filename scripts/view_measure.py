@@ -8,6 +8,7 @@ Usage: view_measure.py URL [--mode decoupled] [--seconds 10] [--sizes 960x710,12
                        [--screenshot view.png]"""
 
 import argparse
+import functools
 import base64
 import os
 import sys
@@ -15,6 +16,8 @@ import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
 import cdp  # noqa: E402
+
+print = functools.partial(print, flush=True)  # progress while a long run goes on
 
 
 def percentile(values, p):
@@ -24,8 +27,8 @@ def percentile(values, p):
 
 def measure(browser, url, mode, width, height, seconds):
     browser.call("Page.navigate", {"url": "%s?w=%d&h=%d&mode=%s" % (url, width, height, mode)})
-    browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 2",
-                     timeout=600, what="the first frames")
+    browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 1",
+                     timeout=600, what="the first frame")
     time.sleep(1.0)
     rect = browser.evaluate("(() => { const r = document.getElementById('frame')"
                             ".getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })()")

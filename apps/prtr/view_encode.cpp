@@ -39,6 +39,26 @@ const std::array<float, 255>& code_thresholds() {
   return thresholds;
 }
 
+// A first guess per bucket of floats (the top 18 bits: exponent and 10 mantissa bits): the
+// code at the bucket's start, which no value in the bucket is below. A value then only steps
+// past the few thresholds inside its bucket, so the result is still exact, at a table load
+// and a branch that is almost always not taken instead of a binary search.
+constexpr int kBucketShift = 13;
+const std::vector<std::uint8_t>& bucket_codes() {
+  static const std::vector<std::uint8_t> codes = [] {
+    const std::array<float, 255>& t = code_thresholds();
+    std::vector<std::uint8_t> c(std::size_t(1) << (31 - kBucketShift));
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      const float start = std::bit_cast<float>(std::uint32_t(k << kBucketShift));
+      c[k] = std::isnan(start)
+                 ? 0
+                 : std::uint8_t(std::upper_bound(t.begin(), t.end(), start) - t.begin());
+    }
+    return c;
+  }();
+  return codes;
+}
+
 struct TjHandle {
   tjhandle handle;
   explicit TjHandle(tjhandle h) : handle(h) {
@@ -53,6 +73,7 @@ struct TjHandle {
 
 std::vector<std::uint8_t> tone_map_rgb8(const render::Image& image, double exposure) {
   const std::array<float, 255>& t = code_thresholds();
+  const std::vector<std::uint8_t>& guess = bucket_codes();
   const std::size_t pixels = std::size_t(image.width) * std::size_t(image.height);
   std::vector<std::uint8_t> rgb(pixels * 3);
   const double scale = std::exp2(exposure);
@@ -60,7 +81,9 @@ std::vector<std::uint8_t> tone_map_rgb8(const render::Image& image, double expos
     for (int c = 0; c < 3; ++c) {
       // As render::tone_map: exposure applied in double, negatives (and NaN) to 0.
       const float x = std::max(0.f, float(double(image.rgba[p * 4 + c]) * scale));
-      rgb[p * 3 + c] = std::uint8_t(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+      unsigned code = guess[std::bit_cast<std::uint32_t>(x) >> kBucketShift];
+      while (code < 255 && x >= t[code]) ++code;
+      rgb[p * 3 + c] = std::uint8_t(code);
     }
   return rgb;
 }

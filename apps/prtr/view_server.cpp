@@ -192,6 +192,9 @@ void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions&
   httplib::Server server;
   const int threads = options.threads;
   server.new_task_queue = [threads] { return new httplib::ThreadPool(std::size_t(threads)); };
+  // Headers and body go out in separate writes: with Nagle's algorithm the body waits for
+  // the client's delayed ACK (~40 ms on Linux), longer than a small frame takes to render.
+  server.set_tcp_nodelay(true);
   add_routes(server, queue, served);
   const int port = bind(server, options);
   StopSignals signals;
