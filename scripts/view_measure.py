@@ -68,7 +68,8 @@ def main():
             log, fps = measure(browser, a.url, a.mode, w, h, a.seconds)
             print("%s %d x %d: %d frames, %.2f FPS during a %.0f s drag" %
                   (a.mode, w, h, len(log), fps, a.seconds))
-            for part in ("total", "queue", "render", "frame", "overlay", "encode", "transfer"):
+            for part in ("total", "queue", "render", "frame", "readback", "overlay", "encode",
+                         "transfer"):
                 values = [e[part] for e in log]
                 print("  %-8s median %7.1f ms   p95 %7.1f ms" %
                       (part, percentile(values, 50), percentile(values, 95)))

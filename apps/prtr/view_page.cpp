@@ -109,7 +109,7 @@ async function pump() {
       const now = performance.now();
       const server = f.queue_ms + f.render_ms + f.overlay_ms + f.encode_ms;
       log.push({ sent: sent, shown: now, queue: f.queue_ms, render: f.render_ms,
-                 frame: f.frame_ms, overlay: f.overlay_ms, encode: f.encode_ms,
+                 frame: f.frame_ms, readback: f.readback_ms, overlay: f.overlay_ms, encode: f.encode_ms,
                  transfer: Math.max(0, now - sent - server), total: now - sent });
       if (log.length > 2000) log.splice(0, 1000);
       showStats(f, now - sent, server);

@@ -163,7 +163,9 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   frame.stats.setup_ms = ms_since(setup_start);
   const render::Camera camera = view_camera(inputs.view, *inputs.mesh, s);
   const render::FrameTiming t = cached.renderer->render(camera, sh, environment_rotation(axis, s));
+  const auto read_start = Clock::now();
   frame.image = cached.renderer->read_image();
+  frame.stats.readback_ms = ms_since(read_start);
   frame.stats.render_ms = ms_since(start);
   frame.stats.frame_ms = t.total_ms;
   frame.stats.cpu_ms = t.cpu_ms;

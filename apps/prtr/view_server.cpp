@@ -180,6 +180,7 @@ Json frame_header(const RenderedFrame& f) {
               {"setup_ms", t.setup_ms},
               {"render_ms", t.render_ms},
               {"frame_ms", t.frame_ms},
+              {"readback_ms", t.readback_ms},
               {"cpu_ms", t.cpu_ms},
               {"gl_ms", t.gl_ms},
               {"overlay_ms", t.overlay_ms},
