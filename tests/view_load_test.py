@@ -123,7 +123,9 @@ def main():
         failures.append("valid requests unanswered: %s" % stats["errors"])
     if stats["refused"] != stats["malformed"]:
         failures.append("malformed requests not refused with 400/404")
-    if second > bound:
+    if "ASAN_OPTIONS" in os.environ:  # scripts/sanitize.sh: freed memory waits in quarantine
+        print("note: RSS bound not enforced under AddressSanitizer (its quarantine grows)")
+    elif second > bound:
         failures.append("RSS grew beyond %d MiB" % (bound // 1024))
     if code != 0:
         failures.append("exit code %s after SIGTERM" % code)
