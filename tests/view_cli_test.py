@@ -10,6 +10,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -154,6 +155,10 @@ def main():
     check("SIGTERM exits 0", code == 0, "(exit %s; stderr %s)" % (code, server.proc.stderr.read()))
     check("prints how many requests it served",
           any("stopped after" in line for line in server.lines), "".join(server.lines))
+    again = vs.ViewServer(prtr, [mesh, "--probe", probe, "--cache", cache] + vs.SMALL_BAKE)
+    status, _, _ = again.get(vs.frame_query(w=32, h=24))
+    code = again.stop(signal.SIGINT)
+    check("Ctrl-C (SIGINT) exits 0", status == 200 and code == 0, "(%d, exit %s)" % (status, code))
     check_usage(prtr, mesh, probe, cache)
     leftovers = [f for f in os.listdir(cache) if "tmp" in f]
     check("no temporary files in the cache", not leftovers, str(leftovers))
