@@ -7,6 +7,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <functional>
 #include <limits>
@@ -67,80 +68,67 @@ bool valid_client(const std::string& id) {
 
 using Setter = std::function<void(ViewState&, const std::string&, const ViewLimits&)>;
 
+void set_client(ViewState& s, const std::string& v, const ViewLimits&) {
+  if (!valid_client(v)) reject("client", v, "use 1-32 of A-Z a-z 0-9 _ -");
+  s.client = v;
+}
+
+void set_mode(ViewState& s, const std::string& v, const ViewLimits& l) {
+  try {
+    s.mode = render::parse_mode(v);
+  } catch (const std::invalid_argument&) {
+    reject("mode", v, "unknown render mode");
+  }
+  if (s.mode == render::Mode::kUncompressed && !l.uncompressed)
+    reject("mode", v, "the transfer set is not loaded");
+}
+
+void set_strategy(ViewState& s, const std::string& v, const ViewLimits&) {
+  try {
+    cpca::find_supercluster_strategy(v);
+  } catch (const std::invalid_argument&) {
+    reject("strategy", v, "use " + cpca::supercluster_strategy_names());
+  }
+  s.strategy = v;
+}
+
+void set_overlay(ViewState& s, const std::string& v, const ViewLimits&) {
+  try {
+    s.overlay = common::parse_enum<Overlay>(kOverlayNames, v, "overlay");
+  } catch (const std::invalid_argument&) {
+    reject("overlay", v, "use " + common::enum_name_list<Overlay>(kOverlayNames));
+  }
+}
+
 // One entry per parameter: its name and how it lands in the state. Angles accept any finite
 // value a page could accumulate by dragging, but not the magnitudes where degrees lose their
-// fraction.
+// fraction; the camera does not go over the pole (its up vector would flip).
 const std::vector<std::pair<std::string, Setter>>& setters() {
+  using S = ViewState;
+  using V = const std::string&;
+  using L = const ViewLimits&;
   static const std::vector<std::pair<std::string, Setter>> table = {
-      {"client",
-       [](ViewState& s, const std::string& v, const ViewLimits&) {
-         if (!valid_client(v)) reject("client", v, "use 1-32 of A-Z a-z 0-9 _ -");
-         s.client = v;
-       }},
-      {"seq",
-       [](ViewState& s, const std::string& v, const ViewLimits&) {
-         s.seq = std::uint64_t(parse_integer("seq", v, 0, std::numeric_limits<long long>::max()));
-       }},
-      {"w", [](ViewState& s, const std::string& v,
-               const ViewLimits& l) { s.width = int(parse_integer("w", v, 16, l.max_side)); }},
-      {"h", [](ViewState& s, const std::string& v,
-               const ViewLimits& l) { s.height = int(parse_integer("h", v, 16, l.max_side)); }},
-      {"env_yaw", [](ViewState& s, const std::string& v,
-                     const ViewLimits&) { s.env_yaw = parse_double("env_yaw", v, -1e6, 1e6); }},
-      {"env_pitch",
-       [](ViewState& s, const std::string& v, const ViewLimits&) {
-         s.env_pitch = parse_double("env_pitch", v, -1e6, 1e6);
-       }},
-      {"cam_yaw", [](ViewState& s, const std::string& v,
-                     const ViewLimits&) { s.cam_yaw = parse_double("cam_yaw", v, -1e6, 1e6); }},
-      {"cam_pitch",
-       [](ViewState& s, const std::string& v, const ViewLimits&) {
-         // Not over the pole: the camera's up vector would flip.
-         s.cam_pitch = parse_double("cam_pitch", v, -89, 89);
-       }},
-      {"zoom", [](ViewState& s, const std::string& v,
-                  const ViewLimits&) { s.zoom = parse_double("zoom", v, 0.1, 20); }},
-      {"mode",
-       [](ViewState& s, const std::string& v, const ViewLimits& l) {
-         try {
-           s.mode = render::parse_mode(v);
-         } catch (const std::invalid_argument&) {
-           reject("mode", v, "unknown render mode");
-         }
-         if (s.mode == render::Mode::kUncompressed && !l.uncompressed)
-           reject("mode", v, "the transfer set is not loaded");
-       }},
-      {"strategy",
-       [](ViewState& s, const std::string& v, const ViewLimits&) {
-         try {
-           cpca::find_supercluster_strategy(v);
-         } catch (const std::invalid_argument&) {
-           reject("strategy", v, "use " + cpca::supercluster_strategy_names());
-         }
-         s.strategy = v;
-       }},
+      {"client", set_client},
+      {"seq", [](S& s, V v, L) { s.seq = std::uint64_t(parse_integer("seq", v, 0, INT64_MAX)); }},
+      {"w", [](S& s, V v, L l) { s.width = int(parse_integer("w", v, 16, l.max_side)); }},
+      {"h", [](S& s, V v, L l) { s.height = int(parse_integer("h", v, 16, l.max_side)); }},
+      {"env_yaw", [](S& s, V v, L) { s.env_yaw = parse_double("env_yaw", v, -1e6, 1e6); }},
+      {"env_pitch", [](S& s, V v, L) { s.env_pitch = parse_double("env_pitch", v, -1e6, 1e6); }},
+      {"cam_yaw", [](S& s, V v, L) { s.cam_yaw = parse_double("cam_yaw", v, -1e6, 1e6); }},
+      {"cam_pitch", [](S& s, V v, L) { s.cam_pitch = parse_double("cam_pitch", v, -89, 89); }},
+      {"zoom", [](S& s, V v, L) { s.zoom = parse_double("zoom", v, 0.1, 20); }},
+      {"mode", set_mode},
+      {"strategy", set_strategy},
       {"budget",
-       [](ViewState& s, const std::string& v, const ViewLimits& l) {
+       [](S& s, V v, L l) {
          s.register_budget = int(parse_integer("budget", v, 0, l.max_register_budget));
        }},
-      {"cpp",
-       [](ViewState& s, const std::string& v, const ViewLimits& l) {
-         s.clusters_per_pass = int(parse_integer("cpp", v, 0, l.cluster_count));
-       }},
+      {"cpp", [](S& s, V v,
+                 L l) { s.clusters_per_pass = int(parse_integer("cpp", v, 0, l.cluster_count)); }},
       {"probe",
-       [](ViewState& s, const std::string& v, const ViewLimits& l) {
-         s.probe = int(parse_integer("probe", v, 0, l.probe_count - 1));
-       }},
-      {"exposure", [](ViewState& s, const std::string& v,
-                      const ViewLimits&) { s.exposure = parse_double("exposure", v, -20, 20); }},
-      {"overlay",
-       [](ViewState& s, const std::string& v, const ViewLimits&) {
-         try {
-           s.overlay = common::parse_enum<Overlay>(kOverlayNames, v, "overlay");
-         } catch (const std::invalid_argument&) {
-           reject("overlay", v, "use " + common::enum_name_list<Overlay>(kOverlayNames));
-         }
-       }},
+       [](S& s, V v, L l) { s.probe = int(parse_integer("probe", v, 0, l.probe_count - 1)); }},
+      {"exposure", [](S& s, V v, L) { s.exposure = parse_double("exposure", v, -20, 20); }},
+      {"overlay", set_overlay},
   };
   return table;
 }
