@@ -92,6 +92,7 @@ class Browser:
         target = self.call("Target.createTarget", {"url": url}, session=False)["targetId"]
         self.session = self.call("Target.attachToTarget", {"targetId": target, "flatten": True},
                                  session=False)["sessionId"]
+        return self.session  # assign .session to switch between opened pages
 
     def evaluate(self, expression, timeout=30):
         result = self.call("Runtime.evaluate", {"expression": expression, "returnByValue": True,

@@ -4,7 +4,8 @@ protocol (tests/cdp.py). Opens the page on a generated sphere at 320 x 237, wait
 first frame and checks it is not blank, drags across it and checks the image and the
 environment angle in the statistics change, switches to multipass with one cluster per pass
 and checks passes and overdraw update, toggles the overdraw overlay and checks the image
-changes, and saves a screenshot (view_browser.png in TMPDIR). Exit 77 (skip) only when
+changes, opens a second tab with its own state (the first keeps its view), and saves a
+screenshot (view_browser.png in TMPDIR). Exit 77 (skip) only when
 /usr/bin/chromium is absent.
 Usage: view_browser_test.py PRTR TMPDIR"""
 
@@ -74,6 +75,24 @@ def set_control(browser, element, value):
                      " e.dispatchEvent(new Event('change')); })()" % (element, value))
 
 
+def check_second_tab(browser, server):
+    """A second tab has its own state: its frames do not change the first tab's view."""
+    first_tab = browser.session
+    browser.open(server.url + "?w=160&h=118&mode=cpu")
+    browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 1",
+                     timeout=60, what="the second tab's first frame")
+    check("second tab: its own mode", text(browser, "stat-mode") == "cpu" and
+          text(browser, "stat-passes") == "1", text(browser, "stat-mode"))
+    second_env = text(browser, "stat-env")
+    browser.session = first_tab
+    n = frames(browser)
+    browser.evaluate("document.getElementById('reset').click()")
+    settle(browser, n, "a frame of the first tab after the second rendered")
+    check("first tab keeps its mode and passes", text(browser, "stat-mode").startswith("multipass")
+          and text(browser, "stat-passes") == "4", text(browser, "stat-mode"))
+    check("second tab's angle is its own", second_env.startswith("yaw 0.0°"), second_env)
+
+
 def run(browser, server, tmp):
     browser.open(server.url + "?w=320&h=237")
     browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 1",
@@ -122,6 +141,7 @@ def run(browser, server, tmp):
     overlaid = browser.evaluate(PIXELS)
     check("overdraw overlay changes the frame", overlaid["hash"] != plain["hash"])
     check("no error shown", text(browser, "stat-error") == "", text(browser, "stat-error"))
+    check_second_tab(browser, server)
     shot = browser.call("Page.captureScreenshot", {"format": "png"})["data"]
     path = os.path.join(tmp, "view_browser.png")
     with open(path, "wb") as f:
