@@ -19,6 +19,9 @@ packages=(
   libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
   ffmpeg python3-matplotlib
+  libcpp-httplib-dev    # prtr view: the HTTP server
+  libturbojpeg0-dev     # prtr view: JPEG frames
+  chromium              # prtr view's end-to-end test drives it headless (run, not linked)
   glmark2-data blender-data
 )
 

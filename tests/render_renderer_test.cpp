@@ -470,6 +470,31 @@ TEST(Renderer, BackgroundIsTheRotatedProbe) {
   EXPECT_EQ(solid.pixel(0, 0)[2], 0.75f);
 }
 
+// A viewer switches probes on a live renderer: the background is then the new probe's, as
+// the same B-spline lookup predicts, and no longer the old one's.
+TEST(Renderer, SetProbeReplacesTheBackground) {
+  render::GlContext ctx;
+  Scene s = make_scene(meshes::make_sphere(0.2f, 8, 4), 2, 8, 1);
+  s.camera = render::frame_sphere(Eigen::Vector3d::Zero(), 3.0, 40, 30, 60.0);
+  const probes::Probe other = probes::make_from_function(32, 16, [](const Eigen::Vector3d& d) {
+    return probes::Rgb(float(1.5 + d.x()), float(0.2 + 0.1 * d.y()), 3.f);
+  });
+  const Eigen::Matrix3d R = test_rotation();
+  render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, options(render::Mode::kSinglepass));
+  r.render(s.camera, s.lighting, R);
+  r.set_probe(&other);
+  r.render(s.camera, s.lighting, R);
+  const render::Image image = r.read_image();
+  for (auto [x, y] : {std::pair{0, 0}, {39, 0}, {0, 29}, {39, 29}, {5, 20}}) {
+    const Eigen::Vector3d w = R.transpose() * s.camera.pixel_direction(x, y);
+    const probes::Rgb expected = bspline_lookup(other, w);
+    const probes::Rgb old = bspline_lookup(s.probe, w);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(image.pixel(x, y)[c], expected[c], 2e-3 * expected.maxCoeff()) << x << "," << y;
+    EXPECT_GT((old - expected).cwiseAbs().maxCoeff(), 0.1f);  // the test can tell them apart
+  }
+}
+
 // Magnified texels of a checkerboard probe: the image follows the B-spline, and so is not
 // the bilinear lookup (which the smooth test probe above cannot tell apart).
 TEST(Renderer, MagnifiedBackgroundIsBsplineNotBilinear) {

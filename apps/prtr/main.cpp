@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   add(prtr_app::add_relight_command);
   add(prtr_app::add_overdraw_command);
   add(prtr_app::add_render_command);
+  add(prtr_app::add_view_command);
   add(prtr_app::add_info_command);
   add(prtr_app::add_gl_info_command);
 

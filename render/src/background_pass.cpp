@@ -16,9 +16,14 @@ BackgroundPass::BackgroundPass(const probes::Probe* probe)
     : program_("background", background_vertex_shader(), background_fragment_shader()) {
   glGenVertexArrays(1, &vao_);
   glGenTextures(1, &texture_);
+  set_probe(probe);
+}
+
+void BackgroundPass::set_probe(const probes::Probe* probe) {
   glBindTexture(GL_TEXTURE_2D, texture_);
   std::vector<float> texels;
   int tw = 2, th = 1;
+  have_probe_ = false;
   if (probe && probe->width() > 0) {
     tw = probe->width();
     th = probe->height();

@@ -20,6 +20,8 @@ class BackgroundPass {
   BackgroundPass(const BackgroundPass&) = delete;
   BackgroundPass& operator=(const BackgroundPass&) = delete;
 
+  // Replaces the texture (a viewer switching probes); same rules as the constructor.
+  void set_probe(const probes::Probe* probe);
   bool has_probe() const { return have_probe_; }
   // Where the depth buffer still holds the cleared 1.0; colour only, alpha kept (coverage).
   void draw(const Camera& camera, const Eigen::Matrix3d& rotation);

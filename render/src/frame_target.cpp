@@ -49,14 +49,14 @@ Image FrameTarget::read() const {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glReadBuffer(GL_COLOR_ATTACHMENT0);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  std::vector<float> rows(image.rgba.size());
-  glReadPixels(0, 0, image.width, image.height, GL_RGBA, GL_FLOAT, rows.data());
+  glReadPixels(0, 0, image.width, image.height, GL_RGBA, GL_FLOAT, image.rgba.data());
   check_gl("Renderer::read_image");
-  // GL's row 0 is the bottom one.
+  // GL's row 0 is the bottom one: swap rows in place (no second frame-sized buffer).
   const std::size_t row = std::size_t(image.width) * 4;
-  for (int y = 0; y < image.height; ++y)
-    std::copy_n(rows.data() + std::size_t(image.height - 1 - y) * row, row,
-                image.rgba.data() + std::size_t(y) * row);
+  for (int y = 0; y < image.height / 2; ++y)
+    std::swap_ranges(image.rgba.begin() + std::ptrdiff_t(std::size_t(y) * row),
+                     image.rgba.begin() + std::ptrdiff_t(std::size_t(y + 1) * row),
+                     image.rgba.begin() + std::ptrdiff_t(std::size_t(image.height - 1 - y) * row));
   return image;
 }
 

@@ -176,6 +176,10 @@ void Renderer::set_background(const Background& background) {
   impl_->background = background;
 }
 
+void Renderer::set_probe(const probes::Probe* probe) {
+  impl_->background_pass.set_probe(probe);
+}
+
 void Renderer::set_count_work(bool on) {
   impl_->options.count_work = on;
 }

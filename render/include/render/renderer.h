@@ -125,6 +125,9 @@ class Renderer {
   Renderer& operator=(const Renderer&) = delete;
 
   void set_background(const Background& background);
+  // Uploads another probe as the background (may be null: none), e.g. when a viewer switches
+  // probes; like the constructor's, it is not kept. The lighting is render()'s argument.
+  void set_probe(const probes::Probe* probe);
   // RendererOptions::count_work for the following frames (timing frames leave it off so the
   // queries cost nothing there).
   void set_count_work(bool on);

@@ -1,0 +1,181 @@
+// prtr view MESH --probe PROBE: interactive relighting in a browser. Bakes and compresses
+// through the cache as relight does, then serves a page (view_page.h) that asks for frames
+// rendered on demand by one OSMesa renderer (view_scene.h, view_server.h).
+#include "bake_flags.h"
+#include "commands.h"
+#include "compress_flags.h"
+#include "cpca/compressed_file.h"
+#include "cpca/supercluster_strategy.h"
+#include "flag_checks.h"
+#include "meshes/load.h"
+#include "pipeline.h"
+#include "probes/load.h"
+#include "view_flags.h"
+#include "view_scene.h"
+#include "view_server.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace prtr_app {
+namespace fs = std::filesystem;
+namespace {
+
+struct Options {
+  std::string mesh, probe, cache, mode = "decoupled", strategy = "greedy-refine";
+  BakeFlags bake;
+  CompressFlags compress;
+  ViewFlags view;
+  ServerOptions server;
+  int register_budget = 0;
+  bool quiet = false;
+};
+
+void add_flags(CLI::App* cmd, Options& o) {
+  cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, OFF, STL, 3DS)")->required();
+  cmd->add_option("--probe", o.probe,
+                  "Light probe (EXR/HDR); the page offers every *.exr/*.hdr in its folder")
+      ->required();
+  cmd->add_option("--mode", o.mode, "Initial rendering path")
+      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu", "uncompressed"}))
+      ->capture_default_str();
+  cmd->add_option("--strategy", o.strategy, "Initial super-cluster strategy")
+      ->capture_default_str();
+  cmd->add_option("--register-budget", o.register_budget,
+                  "Initial vec4 registers per pass (0: what the GL context offers)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
+  add_bake_flags(cmd, o.bake);
+  o.view.width = 960;  // the page's default size; it can ask for others
+  o.view.height = 710;
+  add_view_flags(cmd, o.view);
+  cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
+  cmd->add_option("--host", o.server.host, "Address to listen on")->capture_default_str();
+  cmd->add_option("--port", o.server.port, "Port to listen on (0: any free port)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
+}
+
+bool is_probe_file(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return ext == ".exr" || ext == ".hdr";
+}
+
+// The probes the page may choose: the *.exr/*.hdr beside --probe, by name, --probe among them.
+// Only this list is ever opened; requests name an index into it.
+std::vector<fs::path> scan_probes(const fs::path& given, int& index) {
+  const fs::path probe = given.lexically_normal();
+  std::vector<fs::path> found;
+  std::error_code ec;
+  const fs::path dir = probe.has_parent_path() ? probe.parent_path() : fs::path(".");
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file(ec) && is_probe_file(entry.path()))
+      found.push_back(entry.path().lexically_normal());
+  if (std::find(found.begin(), found.end(), probe) == found.end()) found.push_back(probe);
+  std::sort(found.begin(), found.end());
+  index = int(std::find(found.begin(), found.end(), probe) - found.begin());
+  return found;
+}
+
+Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::CompressedSet& set,
+               const CompressionSummary& summary, const SceneInfo& scene,
+               const std::vector<fs::path>& probes, const ServedInfo& served) {
+  Json names = Json::array();
+  for (const fs::path& p : probes) names.push_back(p.filename().string());
+  Json strategies = Json::array();
+  for (const auto& s : cpca::supercluster_strategies()) strategies.push_back(std::string(s.name));
+  const ViewState& d = served.defaults;
+  return Json{{"mesh", fs::path(o.mesh).filename().string()},
+              {"vertices", mesh.vertex_count()},
+              {"triangles", mesh.triangle_count()},
+              {"clusters", set.cluster_count},
+              {"pcs", set.component_count},
+              {"order", set.order},
+              {"average_se", summary.average_se},
+              {"relative_error", summary.relative_error},
+              {"gl_renderer", scene.gl_renderer},
+              {"gl_version", scene.gl_version},
+              {"llvmpipe_threads", scene.llvmpipe_threads},
+              {"llvmpipe_threads_source", scene.llvmpipe_threads_source},
+              {"default_register_budget", scene.default_register_budget},
+              {"registers_per_cluster", scene.registers_per_cluster},
+              {"modes", render::mode_names()},
+              {"strategies", strategies},
+              {"probes", names},
+              {"defaults",
+               {{"mode", render::mode_name(d.mode)},
+                {"strategy", d.strategy},
+                {"probe", d.probe},
+                {"exposure", d.exposure},
+                {"width", d.width},
+                {"height", d.height}}}};
+}
+
+ViewState initial_state(const Options& o, int probe) {
+  try {
+    cpca::find_supercluster_strategy(o.strategy);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--strategy: ") + e.what());
+  }
+  ViewState s;
+  s.width = o.view.width;
+  s.height = o.view.height;
+  s.mode = render::parse_mode(o.mode);
+  s.strategy = o.strategy;
+  s.register_budget = o.register_budget;
+  s.probe = probe;
+  s.exposure = o.view.exposure;
+  return s;
+}
+
+}  // namespace
+
+Runner add_view_command(CLI::App& app) {
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "view",
+      "Bake, compress (cached) and serve MESH under PROBE to a browser: drag to relight, with "
+      "render modes, probes, overlays and live statistics");
+  add_flags(cmd, *opt);
+
+  return [opt] {
+    const Options& o = *opt;
+    const prt::BakeOptions bake = resolve_bake_flags(o.bake);
+    const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
+    resolve_background(o.view);
+    int probe_index = 0;
+    const std::vector<fs::path> probes = scan_probes(o.probe, probe_index);
+    ServedInfo served;
+    served.defaults = initial_state(o, probe_index);
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    resolve_camera(o.view, mesh);
+    probes::load_probe(o.probe);  // fail before the long work
+    const fs::path cache = o.cache.empty() ? default_cache_dir() : fs::path(o.cache);
+    const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
+    const CompressCacheResult compressed =
+        cached_compress(transfer.path, mesh, o.mesh, compress, cache, o.quiet);
+    const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
+    ViewScene scene({&mesh, &set, transfer.path, probes, o.view});
+    served.limits = {int(probes.size()), set.cluster_count, true};
+    // The initial state renders once here, so a flag the renderer refuses exits 2 now.
+    const auto first = scene.render(served.defaults);
+    if (!first->request_error.empty()) throw UsageError(first->request_error);
+    if (!first->server_error.empty()) throw std::runtime_error(first->server_error);
+    served.info = info_json(o, mesh, set, compressed.summary, scene.info(), probes, served);
+    std::printf("prtr view: %s, %d clusters x %d PCs, order %d; first frame %.0f ms\n",
+                o.mesh.c_str(), set.cluster_count, set.component_count, set.order,
+                first->stats.render_ms);
+    serve_view(scene, served, o.server);
+  };
+}
+
+}  // namespace prtr_app

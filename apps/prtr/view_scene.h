@@ -1,0 +1,61 @@
+// apps/prtr/view_scene.h: the GL side of `prtr view`, owned by its single render thread: the
+// OSMesa context, a few renderers (one per mode / strategy / budget, least recently used
+// dropped), the probes (projected to SH on first use and cached) and the camera. Turns a
+// ViewState into a RenderedFrame. Construct, use and destroy it on one thread.
+#pragma once
+
+#include "cpca/compressed.h"
+#include "meshes/mesh.h"
+#include "view_flags.h"
+#include "view_frame.h"
+#include "view_request.h"
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace prtr_app {
+
+struct SceneInputs {
+  const meshes::Mesh* mesh = nullptr;
+  const cpca::CompressedSet* set = nullptr;
+  std::filesystem::path transfer;  // the cached bake, loaded on the first uncompressed frame
+  std::vector<std::filesystem::path> probes;
+  ViewFlags view;  // camera, background and rotation axis (width/height come per request)
+};
+
+// What does not change while the server runs (the page's "about" statistics).
+struct SceneInfo {
+  std::string gl_renderer, gl_version;
+  int llvmpipe_threads = 0;
+  std::string llvmpipe_threads_source;  // "LP_NUM_THREADS" or "CPUs"
+  int default_register_budget = 0, registers_per_cluster = 0;
+};
+
+class ViewScene {
+ public:
+  explicit ViewScene(SceneInputs inputs);
+  ~ViewScene();
+  ViewScene(const ViewScene&) = delete;
+  ViewScene& operator=(const ViewScene&) = delete;
+
+  const SceneInfo& info() const;
+  // Never throws for a bad state: request_error / server_error say what went wrong.
+  std::shared_ptr<RenderedFrame> render(const ViewState& state);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The camera a state asks for: the flags' framing (or --eye/--target/--up) at the state's
+// size, orbited by cam_yaw about +Y and cam_pitch about the camera's right axis around the
+// target, moved zoom times closer; clip planes refitted to the mesh.
+render::Camera view_camera(const ViewFlags& flags, const meshes::Mesh& mesh,
+                           const ViewState& state);
+
+// The environment rotation: env_yaw about `axis`, then env_pitch about +X.
+Eigen::Matrix3d environment_rotation(const Eigen::Vector3d& axis, const ViewState& state);
+
+}  // namespace prtr_app

@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""prtr view over loopback: starts the real binary on a generated sphere and probes (--port 0),
+checks the page, /api/info, frames (JPEG headers, decoded by oiiotool when installed, not
+blank, changing with the environment, the probe and the overlay), multipass statistics,
+400 for every malformed parameter, 404 for unknown paths, the server surviving garbage on
+the socket, and SIGTERM exiting 0 with no temporary files in the cache.
+Usage: view_cli_test.py PRTR TMPDIR"""
+
+import json
+import os
+import re
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import view_support as vs  # noqa: E402
+
+passed = failed = 0
+
+
+def check(name, ok, detail=""):
+    global passed, failed
+    if ok:
+        passed += 1
+    else:
+        failed += 1
+        print("FAIL: %s %s" % (name, detail))
+
+
+def oiio_stats(path):
+    """(min, max, stddev) of the first channel as oiiotool decodes the file, or None."""
+    if not shutil.which("oiiotool"):
+        return None
+    out = subprocess.run(["oiiotool", "--stats", path], capture_output=True, text=True).stdout
+    get = lambda key: [float(x) for x in re.search(key + r":\s+([-0-9. e]+)", out).group(1).split()]
+    return get("Stats Min")[0], get("Stats Max")[0], get("Stats StdDev")[0]
+
+
+def frame(server, name, **params):
+    status, headers, body = server.get(vs.frame_query(**params))
+    ok = status == 200 and headers.get("content-type") == "image/jpeg"
+    check(name + ": 200 image/jpeg", ok, "(%d %s)" % (status, body[:200]))
+    return (body, vs.frame_info(headers)) if ok else (b"", {})
+
+
+def check_frames(server, tmp):
+    base = dict(client="t", w=64, h=48)
+    body, info = frame(server, "first frame", seq=1, **base)
+    check("frame is a 64 x 48 JPEG", vs.jpeg_size(body) == (64, 48), str(vs.jpeg_size(body)))
+    path = os.path.join(tmp, "frame.jpg")
+    with open(path, "wb") as f:
+        f.write(body)
+    stats = oiio_stats(path)
+    if stats is None:
+        print("SKIP: JPEG decode check (oiiotool is not installed)")
+    else:
+        check("frame decodes and is not blank", stats[1] - stats[0] > 0.1 and stats[2] > 0.01,
+              str(stats))
+    turned, tinfo = frame(server, "turned environment", seq=2, env_yaw=90, **base)
+    check("environment rotation changes the frame", turned != body and tinfo.get("env_yaw") == 90)
+    other, _ = frame(server, "second probe", seq=3, probe=1, **base)
+    check("probe switch changes the frame", other != body)
+    over, oinfo = frame(server, "overdraw overlay", seq=4, mode="multipass", cpp=1,
+                        overlay="overdraw", **base)
+    check("multipass: one pass per cluster", oinfo.get("passes") == 4, str(oinfo))
+    check("multipass: overdraw > 1 on a sphere of 4 clusters",
+          oinfo.get("average_overdraw", 0) > 1.0, str(oinfo))
+    plain, _ = frame(server, "multipass without overlay", seq=5, mode="multipass", cpp=1, **base)
+    check("the overlay changes the frame", plain != over)
+    for mode in ("singlepass", "cpu", "uncompressed"):
+        _, minfo = frame(server, mode, seq=6, mode=mode, **base)
+        check(mode + ": reported", minfo.get("mode") == mode, str(minfo))
+
+
+def check_rejections(server):
+    bad = [dict(w="nan"), dict(w=-5), dict(w=100000), dict(h="1e9"), dict(env_yaw="nan"),
+           dict(env_yaw="inf"), dict(cam_pitch=120), dict(mode="warp"), dict(budget=-1),
+           dict(strategy="magic"), dict(probe=2), dict(probe="../../../etc/passwd"),
+           dict(exposure="1e400"), dict(overlay="x"), dict(client="a/b"), dict(zoom=0),
+           dict(unknown=1)]
+    for params in bad:
+        status, _, body = server.get(vs.frame_query(**params))
+        name = next(iter(params))
+        one_line = body.decode(errors="replace").rstrip("\n")
+        check("400 for %s" % params, status == 400 and name in one_line and "\n" not in one_line,
+              "(%d %r)" % (status, body[:200]))
+    status, _, body = server.get("/frame?w=64&h=48&mode=multipass&budget=1")
+    check("400 for a budget that holds no cluster", status == 400, "(%d %r)" % (status, body))
+    status, _, _ = server.get("/frame?w=64&w=65")
+    check("400 for a repeated parameter", status == 400)
+    for path in ["/nope", "/frame/x", "/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd",
+                 "/api/info/../../x", "/probes/a_sky.hdr"]:
+        status, _, body = server.get(path)
+        check("404 for %s" % path, status == 404, "(%d %r)" % (status, body[:100]))
+    status, _, _ = server.get("/frame", method="POST")
+    check("POST /frame is not served", status in (400, 404, 405), str(status))
+    # Garbage on the socket: the server answers or closes, and keeps serving.
+    for junk in [b"GARBAGE\r\n\r\n", b"GET /frame?w=%zz HTTP/1.1\r\nHost: x\r\n\r\n",
+                 b"GET " + b"A" * 20000 + b" HTTP/1.1\r\n\r\n"]:
+        with socket.create_connection((server.host, server.port), timeout=10) as s:
+            s.sendall(junk)
+            try:
+                s.recv(4096)
+            except OSError:
+                pass
+    status, _, _ = server.get(vs.frame_query(w=32, h=24))
+    check("still serving after garbage", status == 200)
+
+
+def check_usage(prtr, mesh, probe, cache):
+    base = [prtr, "view", mesh, "--probe", probe, "--cache", cache, "-q"] + vs.SMALL_BAKE
+    r = subprocess.run(base + ["--strategy", "bogus"], capture_output=True, text=True, timeout=60)
+    check("--strategy bogus: exit 2 naming it", r.returncode == 2 and "--strategy" in r.stderr,
+          r.stderr)
+    r = subprocess.run(base + ["--mode", "multipass", "--register-budget", "1"],
+                       capture_output=True, text=True, timeout=120)
+    check("--register-budget 1: exit 2 naming it",
+          r.returncode == 2 and "--register-budget" in r.stderr, r.stderr)
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        port = s.getsockname()[1]
+        r = subprocess.run(base + ["--port", str(port)], capture_output=True, text=True,
+                           timeout=120)
+    check("a port in use: exit 1 naming it", r.returncode == 1 and str(port) in r.stderr, r.stderr)
+
+
+def main():
+    prtr, tmp = sys.argv[1], sys.argv[2]
+    shutil.rmtree(tmp, ignore_errors=True)
+    os.makedirs(tmp)
+    mesh, probe = vs.write_inputs(tmp)
+    cache = os.path.join(tmp, "cache")
+    server = vs.ViewServer(prtr, [mesh, "--probe", probe, "--cache", cache, "--width", "64",
+                                  "--height", "48"] + vs.SMALL_BAKE)
+    check("listens on 127.0.0.1", server.host == "127.0.0.1", server.url)
+    try:
+        status, headers, body = server.get("/")
+        check("page: 200 HTML", status == 200 and b"<title>prtr view</title>" in body)
+        check("page: no external resources", b"http://" not in body and b"https://" not in body)
+        status, _, body = server.get("/api/info")
+        info = json.loads(body) if status == 200 else {}
+        check("info: probes of the folder, by name",
+              info.get("probes") == ["a_sky.hdr", "b_sunset.hdr"], str(info.get("probes")))
+        check("info: 4 clusters x 2 PCs, order 3",
+              (info.get("clusters"), info.get("pcs"), info.get("order")) == (4, 2, 3))
+        check("info: the GL renderer", "llvmpipe" in info.get("gl_renderer", ""), str(info))
+        check_frames(server, tmp)
+        check_rejections(server)
+    finally:
+        code = server.stop()
+    check("SIGTERM exits 0", code == 0, "(exit %s; stderr %s)" % (code, server.proc.stderr.read()))
+    check("prints how many requests it served",
+          any("stopped after" in line for line in server.lines), "".join(server.lines))
+    again = vs.ViewServer(prtr, [mesh, "--probe", probe, "--cache", cache] + vs.SMALL_BAKE)
+    status, _, _ = again.get(vs.frame_query(w=32, h=24))
+    code = again.stop(signal.SIGINT)
+    check("Ctrl-C (SIGINT) exits 0", status == 200 and code == 0, "(%d, exit %s)" % (status, code))
+    check_usage(prtr, mesh, probe, cache)
+    leftovers = [f for f in os.listdir(cache) if "tmp" in f]
+    check("no temporary files in the cache", not leftovers, str(leftovers))
+    print("view_cli_test: %d passed, %d failed" % (passed, failed))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

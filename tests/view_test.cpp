@@ -1,0 +1,308 @@
+// prtr view's request handling without a network: the query parser (every bad parameter is
+// refused with a one-line reason naming it), the per-client queue (the newest request wins,
+// coalesced requests share one frame, clients are served in turn), the JPEG path (the tone
+// map against render::tone_map itself, a JPEG round trip through libjpeg-turbo's decoder),
+// and the camera and environment a state asks for.
+#include "view_encode.h"
+#include "view_frame.h"
+#include "view_queue.h"
+#include "view_request.h"
+#include "view_scene.h"
+
+#include "meshes/procedural.h"
+#include "render/image.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <future>
+#include <numbers>
+#include <random>
+#include <thread>
+
+namespace {
+
+using prtr_app::FrameQueue;
+using prtr_app::QueryParams;
+using prtr_app::RequestError;
+using prtr_app::ViewLimits;
+using prtr_app::ViewState;
+
+ViewLimits limits() {
+  ViewLimits l;
+  l.probe_count = 3;
+  l.cluster_count = 16;
+  l.uncompressed = false;
+  return l;
+}
+
+TEST(ViewRequest, NoParametersGiveTheDefaults) {
+  ViewState d;
+  d.width = 320;
+  d.probe = 2;
+  const ViewState s = prtr_app::parse_view_request({}, limits(), d);
+  EXPECT_EQ(s.width, 320);
+  EXPECT_EQ(s.probe, 2);
+  EXPECT_EQ(s.mode, render::Mode::kDecoupled);
+}
+
+TEST(ViewRequest, EveryParameterLandsInTheState) {
+  const QueryParams q = {
+      {"client", "tab-1_x"}, {"seq", "42"},         {"w", "640"},          {"h", "474"},
+      {"env_yaw", "-30.5"},  {"env_pitch", "12"},   {"cam_yaw", "90"},     {"cam_pitch", "-45"},
+      {"zoom", "1.5"},       {"mode", "multipass"}, {"strategy", "order"}, {"budget", "512"},
+      {"cpp", "4"},          {"probe", "1"},        {"exposure", "-1.25"}, {"overlay", "overdraw"}};
+  const ViewState s = prtr_app::parse_view_request(q, limits());
+  EXPECT_EQ(s.client, "tab-1_x");
+  EXPECT_EQ(s.seq, 42u);
+  EXPECT_EQ(s.width, 640);
+  EXPECT_EQ(s.height, 474);
+  EXPECT_EQ(s.env_yaw, -30.5);
+  EXPECT_EQ(s.env_pitch, 12);
+  EXPECT_EQ(s.cam_yaw, 90);
+  EXPECT_EQ(s.cam_pitch, -45);
+  EXPECT_EQ(s.zoom, 1.5);
+  EXPECT_EQ(s.mode, render::Mode::kMultipass);
+  EXPECT_EQ(s.strategy, "order");
+  EXPECT_EQ(s.register_budget, 512);
+  EXPECT_EQ(s.clusters_per_pass, 4);
+  EXPECT_EQ(s.probe, 1);
+  EXPECT_EQ(s.exposure, -1.25);
+  EXPECT_EQ(s.overlay, prtr_app::Overlay::kOverdraw);
+  EXPECT_EQ(q.size(), prtr_app::view_parameter_names().size());  // all of them were covered
+}
+
+TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
+  struct Case {
+    QueryParams query;
+    std::string named;
+  };
+  const std::vector<Case> cases = {
+      {{{"bogus", "1"}}, "bogus"},
+      {{{"w", "640"}, {"w", "320"}}, "w"},
+      {{{"w", "0"}}, "w"},
+      {{{"w", "99999"}}, "w"},
+      {{{"h", "abc"}}, "h"},
+      {{{"h", ""}}, "h"},
+      {{{"w", " 64"}}, "w"},
+      {{{"w", "64x"}}, "w"},
+      {{{"w", "+64"}}, "w"},
+      {{{"w", "4096"}, {"h", "4096"}}, "w x h"},
+      {{{"env_yaw", "nan"}}, "env_yaw"},
+      {{{"env_yaw", "NaN"}}, "env_yaw"},
+      {{{"env_pitch", "inf"}}, "env_pitch"},
+      {{{"env_yaw", "1e300"}}, "env_yaw"},
+      {{{"env_yaw", "0x10"}}, "env_yaw"},
+      {{{"cam_pitch", "90"}}, "cam_pitch"},
+      {{{"zoom", "0"}}, "zoom"},
+      {{{"zoom", "-1"}}, "zoom"},
+      {{{"mode", "fast"}}, "mode"},
+      {{{"mode", "uncompressed"}}, "mode"},  // no transfer set in these limits
+      {{{"strategy", "best"}}, "strategy"},
+      {{{"budget", "-1"}}, "budget"},
+      {{{"budget", "99999999999"}}, "budget"},
+      {{{"cpp", "17"}}, "cpp"},
+      {{{"probe", "3"}}, "probe"},
+      {{{"probe", "-1"}}, "probe"},
+      {{{"probe", "../../etc/passwd"}}, "probe"},
+      {{{"exposure", "nan"}}, "exposure"},
+      {{{"exposure", "21"}}, "exposure"},
+      {{{"overlay", "both"}}, "overlay"},
+      {{{"client", "../x"}}, "client"},
+      {{{"client", std::string(33, 'a')}}, "client"},
+      {{{"client", ""}}, "client"},
+      {{{"seq", "-1"}}, "seq"},
+  };
+  for (const Case& c : cases) {
+    try {
+      prtr_app::parse_view_request(c.query, limits());
+      ADD_FAILURE() << "accepted " << c.query.begin()->first << "=" << c.query.begin()->second;
+    } catch (const RequestError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(c.named), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      EXPECT_LT(what.size(), 200u) << what;
+    }
+  }
+}
+
+TEST(ViewRequest, UncompressedIsAcceptedWhenTheTransferIsAtHand) {
+  ViewLimits l = limits();
+  l.uncompressed = true;
+  EXPECT_EQ(prtr_app::parse_view_request({{"mode", "uncompressed"}}, l).mode,
+            render::Mode::kUncompressed);
+}
+
+ViewState state_of(const std::string& client, std::uint64_t seq, double yaw = 0) {
+  ViewState s;
+  s.client = client;
+  s.seq = seq;
+  s.env_yaw = yaw;
+  return s;
+}
+
+std::shared_ptr<prtr_app::RenderedFrame> frame_for(const ViewState& s) {
+  auto f = std::make_shared<prtr_app::RenderedFrame>();
+  f->state = s;
+  return f;
+}
+
+TEST(ViewQueue, NewerRequestsOfAClientReplaceTheWaitingOneAndShareItsFrame) {
+  FrameQueue q;
+  auto first = q.submit(state_of("a", 1, 10));
+  auto second = q.submit(state_of("a", 2, 20));
+  auto late_old = q.submit(state_of("a", 1, 99));  // overtaken on another connection
+  EXPECT_EQ(q.waiting(), 1u);
+  std::optional<FrameQueue::Job> job = q.take();
+  ASSERT_TRUE(job);
+  EXPECT_EQ(job->state.seq, 2u);
+  EXPECT_EQ(job->state.env_yaw, 20);
+  EXPECT_EQ(job->requests, 3);
+  job->promise.set_value(frame_for(job->state));
+  for (auto* f : {&first, &second, &late_old}) EXPECT_EQ(f->get()->state.seq, 2u);
+  EXPECT_EQ(q.counters().coalesced, 2u);
+  // Once taken, the next request is a new job.
+  auto third = q.submit(state_of("a", 3));
+  EXPECT_EQ(q.waiting(), 1u);
+  EXPECT_EQ(q.take()->state.seq, 3u);
+}
+
+TEST(ViewQueue, ClientsAreServedInTurnAndKeepTheirPlace) {
+  FrameQueue q;
+  q.submit(state_of("a", 1));
+  q.submit(state_of("b", 1));
+  q.submit(state_of("a", 2));  // coalesced: a keeps its place ahead of b
+  q.submit(state_of("c", 1));
+  EXPECT_EQ(q.take()->state.client, "a");
+  q.submit(state_of("a", 3));  // a new job, behind b and c
+  EXPECT_EQ(q.take()->state.client, "b");
+  EXPECT_EQ(q.take()->state.client, "c");
+  const auto last = q.take();
+  EXPECT_EQ(last->state.client, "a");
+  EXPECT_EQ(last->state.seq, 3u);
+}
+
+TEST(ViewQueue, RefusesTooManyClientsAndFailsWaitersOnStop) {
+  FrameQueue q(2);
+  auto a = q.submit(state_of("a", 1));
+  auto b = q.submit(state_of("b", 1));
+  EXPECT_THROW(q.submit(state_of("c", 1)), prtr_app::QueueRefused);
+  EXPECT_NO_THROW(q.submit(state_of("a", 2)));  // a waiting client may still coalesce
+  q.stop();
+  EXPECT_THROW(a.get(), prtr_app::QueueRefused);
+  EXPECT_THROW(b.get(), prtr_app::QueueRefused);
+  EXPECT_FALSE(q.take());
+  EXPECT_THROW(q.submit(state_of("a", 3)), prtr_app::QueueRefused);
+}
+
+// Four clients submit as fast as they can while one thread renders: every request gets a
+// frame of its own client, never older than itself.
+TEST(ViewQueue, ConcurrentClientsEachGetTheirNewestFrame) {
+  FrameQueue q;
+  std::thread renderer([&] {
+    while (auto job = q.take()) job->promise.set_value(frame_for(job->state));
+  });
+  std::vector<std::thread> clients;
+  std::atomic<int> answered{0}, wrong{0};
+  for (int c = 0; c < 4; ++c)
+    clients.emplace_back([&, c] {
+      const std::string id = "client" + std::to_string(c);
+      for (std::uint64_t seq = 1; seq <= 200; ++seq) {
+        const prtr_app::FramePtr f = q.submit(state_of(id, seq)).get();
+        if (f->state.client != id || f->state.seq < seq) ++wrong;
+        ++answered;
+      }
+    });
+  for (auto& t : clients) t.join();
+  q.stop();
+  renderer.join();
+  EXPECT_EQ(answered.load(), 800);
+  EXPECT_EQ(wrong.load(), 0);
+}
+
+TEST(ViewEncode, ToneMapMatchesRenderToneMapExactly) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> log_value(-12.f, 8.f);
+  for (double exposure : {0.0, -2.5, 3.0}) {
+    render::Image image;
+    image.width = 256;
+    image.height = 64;
+    image.rgba.resize(std::size_t(image.width) * image.height * 4);
+    for (std::size_t i = 0; i < image.rgba.size(); ++i)
+      image.rgba[i] = i % 97 == 0 ? -1.f : std::exp2(log_value(rng));
+    const std::vector<std::uint8_t> rgb = prtr_app::tone_map_rgb8(image, exposure);
+    int mismatches = 0;
+    for (std::size_t p = 0; p < std::size_t(image.width) * image.height; ++p)
+      for (int c = 0; c < 3; ++c) {
+        const auto expected =
+            std::uint8_t(std::lround(255.f * render::tone_map(image.rgba[p * 4 + c], exposure)));
+        mismatches += rgb[p * 3 + c] != expected;
+      }
+    EXPECT_EQ(mismatches, 0) << "exposure " << exposure;
+  }
+}
+
+TEST(ViewEncode, JpegRoundTripAndOverlay) {
+  const int w = 64, h = 48;
+  std::vector<std::uint8_t> rgb(std::size_t(w) * h * 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      std::uint8_t* p = &rgb[(std::size_t(y) * w + x) * 3];
+      p[0] = std::uint8_t(x * 4);
+      p[1] = std::uint8_t(y * 5);
+      p[2] = 128;
+    }
+  render::Picture overlay(w, h, prtr_app::kOverlayTransparent);
+  overlay.set(10, 10, {0, 0, 0});
+  std::vector<std::uint8_t> mixed = rgb;
+  prtr_app::composite_overlay(mixed, w, h, overlay, 0.5);
+  EXPECT_EQ(mixed[(10 * w + 10) * 3 + 2], 64);  // half of 128 over black
+  mixed[(10 * w + 10) * 3 + 0] = rgb[(10 * w + 10) * 3 + 0];
+  mixed[(10 * w + 10) * 3 + 1] = rgb[(10 * w + 10) * 3 + 1];
+  mixed[(10 * w + 10) * 3 + 2] = rgb[(10 * w + 10) * 3 + 2];
+  EXPECT_EQ(mixed, rgb);  // every transparent pixel untouched
+
+  const std::vector<std::uint8_t> jpeg = prtr_app::encode_jpeg(rgb, w, h, 90);
+  ASSERT_GT(jpeg.size(), 4u);
+  EXPECT_EQ(jpeg[0], 0xFF);
+  EXPECT_EQ(jpeg[1], 0xD8);
+  int dw = 0, dh = 0;
+  const std::vector<std::uint8_t> back = prtr_app::decode_jpeg(jpeg, dw, dh);
+  EXPECT_EQ(dw, w);
+  EXPECT_EQ(dh, h);
+  double error = 0;
+  for (std::size_t i = 0; i < rgb.size(); ++i) error += std::abs(int(back[i]) - int(rgb[i]));
+  EXPECT_LT(error / double(rgb.size()), 3.0);
+  EXPECT_THROW(prtr_app::encode_jpeg(rgb, w + 1, h), std::invalid_argument);
+}
+
+TEST(ViewCamera, OrbitAndZoomMoveTheEyeAboutTheTarget) {
+  const meshes::Mesh mesh = meshes::make_sphere(1.f, 16, 8);
+  prtr_app::ViewFlags flags;
+  ViewState s;
+  s.width = 64;
+  s.height = 48;
+  const render::Camera base = prtr_app::view_camera(flags, mesh, s);
+  EXPECT_EQ(base.width, 64);
+  const double distance = (base.eye - base.target).norm();
+  s.zoom = 2;
+  const render::Camera closer = prtr_app::view_camera(flags, mesh, s);
+  EXPECT_NEAR((closer.eye - closer.target).norm(), distance / 2, 1e-9);
+  s.zoom = 1;
+  s.cam_yaw = 90;
+  const render::Camera side = prtr_app::view_camera(flags, mesh, s);
+  // The default camera looks down -Z; a quarter turn about +Y looks down -X.
+  const Eigen::Vector3d forward = (side.target - side.eye).normalized();
+  EXPECT_NEAR(forward.x(), -1.0, 1e-9);
+  EXPECT_NEAR((side.eye - side.target).norm(), distance, 1e-9);
+  EXPECT_NO_THROW(side.validate());
+  const Eigen::Matrix3d none =
+      prtr_app::environment_rotation(Eigen::Vector3d::UnitY(), ViewState{});
+  EXPECT_TRUE(none.isApprox(Eigen::Matrix3d::Identity()));
+  ViewState turned;
+  turned.env_yaw = 90;
+  const Eigen::Matrix3d r = prtr_app::environment_rotation(Eigen::Vector3d::UnitY(), turned);
+  EXPECT_TRUE((r * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitX(), 1e-12));
+}
+
+}  // namespace
