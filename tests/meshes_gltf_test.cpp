@@ -228,6 +228,18 @@ TEST(GltfErrors, ClaimsPastTheDataAreRefused) {
   expect_load_error(write_file("big_view.gltf", as_gltf(v)), "bufferView 2 spans");
 }
 
+TEST(GltfErrors, DataUrisMustBeBase64) {
+  // Assimp's decoder leaked its buffer on a bad character (found by fuzz_mesh_gltf).
+  std::string text = as_gltf(two_mesh_scene());
+  text[text.find("base64,") + 10] = '*';
+  expect_load_error(write_file("bad_char.gltf", text), "not base64 at offset");
+  Scene s = two_mesh_scene();
+  s.gltf["buffers"][0]["uri"] = "data:application/octet-stream,%00%01";
+  expect_load_error(write_file("not_base64.gltf", s.gltf.dump()), "not base64");
+  s.gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64,QUJD" + std::string(3, 'A');
+  expect_load_error(write_file("ragged.gltf", s.gltf.dump()), "whole number of base64 quads");
+}
+
 TEST(GltfErrors, UrisOutsideTheFolderAreRefused) {
   Scene s = two_mesh_scene();
   write_file("scene.bin", s.bin);

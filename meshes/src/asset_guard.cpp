@@ -130,19 +130,43 @@ std::string percent_decoded(std::string_view uri, const std::string& where) {
   return out;
 }
 
+// The decoded size of a base64 data URI. Its characters are checked here because Assimp's
+// decoder leaks the buffer it was filling when it meets a bad one.
+std::uint64_t data_uri_bytes(std::string_view uri, const std::string& where) {
+  const std::size_t comma = uri.find(',');
+  if (comma == std::string_view::npos || uri.substr(0, comma).find(";base64") == uri.npos) {
+    refuse(where + " has a data URI that is not base64 ('data:...;base64,...'); re-export it");
+  }
+  const std::string_view payload = uri.substr(comma + 1);
+  if (payload.size() / 4 * 3 > kMaxDataUriBytes) {
+    refuse(where + " embeds " + std::to_string(payload.size() / 4 * 3) +
+           " bytes in a data URI, over the " + std::to_string(kMaxDataUriBytes >> 20) +
+           " MiB limit; store them in a .bin or .glb");
+  }
+  const auto is_base64 = [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '+' ||
+           c == '/';
+  };
+  std::size_t padding = 0;
+  while (padding < 2 && padding < payload.size() && payload[payload.size() - 1 - padding] == '=') {
+    ++padding;
+  }
+  for (std::size_t i = 0; i + padding < payload.size(); ++i) {
+    if (!is_base64(payload[i])) {
+      refuse(where + "'s data URI has a character that is not base64 at offset " +
+             std::to_string(comma + 1 + i) + "; the file is damaged");
+    }
+  }
+  if (payload.size() % 4 != 0) {
+    refuse(where + "'s data URI is not a whole number of base64 quads; the file is damaged");
+  }
+  return payload.size() / 4 * 3 - padding;
+}
+
 // The bytes a buffer or image URI stands for: a data URI's decoded size, or the size of a
 // file next to the glTF file. Refuses anything that leaves the file's folder.
 std::uint64_t uri_bytes(const std::string& uri, const fs::path& folder, const std::string& where) {
-  if (uri.rfind("data:", 0) == 0) {
-    const std::size_t comma = uri.find(',');
-    if (comma == std::string::npos) refuse(where + " has a data URI without ','; damaged");
-    const std::uint64_t decoded = (uri.size() - comma - 1) / 4 * 3;
-    if (decoded > kMaxDataUriBytes) {
-      refuse(where + " embeds " + std::to_string(decoded) + " bytes in a data URI, over the " +
-             std::to_string(kMaxDataUriBytes >> 20) + " MiB limit; store them in a .bin or .glb");
-    }
-    return decoded;
-  }
+  if (uri.rfind("data:", 0) == 0) return data_uri_bytes(uri, where);
   const std::string path = percent_decoded(uri, where);
   const fs::path relative(path);
   bool escapes = path.empty() || path.find(':') != std::string::npos ||
