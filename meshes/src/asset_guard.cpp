@@ -329,11 +329,6 @@ void check_meshes(const json& root) {
 void check_nodes(const json& root) {
   const json& nodes = array_at(root, "nodes");
   const std::size_t mesh_count = array_at(root, "meshes").size();
-  if (!array_at(root, "skins").empty()) {
-    refuse(
-        "it has skins (bones), which are not supported; export the mesh in its bind pose "
-        "without the armature");
-  }
   std::vector<std::int64_t> parent(nodes.size(), -1);
   for (std::size_t n = 0; n < nodes.size(); ++n) {
     const std::string where = "node " + std::to_string(n);
@@ -394,6 +389,12 @@ void check_gltf_json(std::string_view text, const fs::path& folder,
              ", which is not supported; export "
              "without mesh compression");
     }
+  }
+  // Unsupported content first: its message helps more than any damage found after it.
+  if (!array_at(root, "skins").empty()) {
+    refuse(
+        "it has skins (bones), which are not supported; export the mesh in its bind pose "
+        "without the armature");
   }
   const std::vector<std::uint64_t> buffers = check_buffers(root, folder, glb_bin);
   check_accessors(root, check_buffer_views(root, buffers));
