@@ -248,6 +248,13 @@ TEST(GltfErrors, UrisOutsideTheFolderAreRefused) {
     s.gltf["buffers"][0]["uri"] = uri;
     expect_load_error(write_file("escape.gltf", s.gltf.dump()), "outside the file's folder");
   }
+  // Images are not needed for geometry: a missing texture beside the file is fine, one
+  // outside the folder is still refused.
+  Scene textured = two_mesh_scene();
+  textured.gltf["images"] = {{{"uri", "missing_texture.png"}}};
+  EXPECT_EQ(meshes::load_mesh(write_file("textured.gltf", as_gltf(textured))).triangle_count(), 3u);
+  textured.gltf["images"][0]["uri"] = "../texture.png";
+  expect_load_error(write_file("textured_escape.gltf", as_gltf(textured)), "image 0 refers to");
 }
 
 TEST(GltfErrors, HostileStructureIsRefusedBeforeAssimp) {

@@ -134,6 +134,33 @@ TEST(Hostile3ds, DeepNestingIsRefusedWithoutRecursion) {
   EXPECT_EQ(meshes::load_mesh(write_file("shallow.3ds", shallow)).triangle_count(), 2u);
 }
 
+TEST(Hostile3ds, KeyframeTrackCountMustFitItsChunk) {
+  // Assimp reserves 24 bytes per key a position track claims before reading any: 2^31 keys
+  // in a 150-byte file asked for 51 GB.
+  std::string vertices = bytes_of(std::uint16_t(4));
+  const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (const auto& v : p) vertices += std::string(reinterpret_cast<const char*>(v), 12);
+  std::string faces = bytes_of(std::uint16_t(2));
+  for (int t = 0; t < 2; ++t) {
+    const std::uint16_t idx[4] = {0, std::uint16_t(1 + t), std::uint16_t(2 + t), 0};
+    faces += std::string(reinterpret_cast<const char*>(idx), 8);
+  }
+  const std::string object =
+      chunk(0x4000, std::string("quad\0", 5) +
+                        chunk(0x4100, chunk(0x4110, vertices) + chunk(0x4120, faces)));
+  const auto with_track = [&](std::uint32_t keys, const std::string& key_bytes) {
+    const std::string name = chunk(0xB010, std::string("quad\0", 5) + std::string(6, '\0'));
+    const std::string track = chunk(0xB020, std::string(10, '\0') + bytes_of(keys) + key_bytes);
+    return chunk(0x4D4D, chunk(0x3D3D, object) + chunk(0xB000, chunk(0xB002, name + track)));
+  };
+  expect_mesh_error(write_file("track_2g.3ds", with_track(0x7FFFFFFF, "")),
+                    "claims 2147483647 keys");
+  // One real key (frame, flags, x y z) fits and loads.
+  const std::string key =
+      bytes_of(std::uint32_t(0)) + bytes_of(std::uint16_t(0)) + std::string(12, '\0');
+  EXPECT_EQ(meshes::load_mesh(write_file("track_1.3ds", with_track(1, key))).triangle_count(), 2u);
+}
+
 // --- OFF ----------------------------------------------------------------------------------
 
 TEST(HostileOff, HeaderCountsAreCheckedAgainstTheFileSize) {

@@ -165,7 +165,10 @@ std::uint64_t data_uri_bytes(std::string_view uri, const std::string& where) {
 
 // The bytes a buffer or image URI stands for: a data URI's decoded size, or the size of a
 // file next to the glTF file. Refuses anything that leaves the file's folder.
-std::uint64_t uri_bytes(const std::string& uri, const fs::path& folder, const std::string& where) {
+// Images are never opened for geometry (Assimp only records external image paths), so a
+// missing image is no error; leaving the folder still is.
+std::uint64_t uri_bytes(const std::string& uri, const fs::path& folder, const std::string& where,
+                        bool must_exist = true) {
   if (uri.rfind("data:", 0) == 0) return data_uri_bytes(uri, where);
   const std::string path = percent_decoded(uri, where);
   const fs::path relative(path);
@@ -177,6 +180,7 @@ std::uint64_t uri_bytes(const std::string& uri, const fs::path& folder, const st
            "', outside the file's folder (or another scheme); "
            "only files beside the .gltf are read: copy them there and use a relative URI");
   }
+  if (!must_exist) return 0;
   std::error_code ec;
   const fs::path target = folder / relative;
   if (!fs::is_regular_file(target, ec)) {
@@ -403,7 +407,7 @@ void check_gltf_json(std::string_view text, const fs::path& folder,
   const json& images = array_at(root, "images");
   for (std::size_t i = 0; i < images.size(); ++i) {
     if (images[i].is_object() && images[i].contains("uri") && images[i]["uri"].is_string()) {
-      uri_bytes(images[i]["uri"].get<std::string>(), folder, "image " + std::to_string(i));
+      uri_bytes(images[i]["uri"].get<std::string>(), folder, "image " + std::to_string(i), false);
     }
   }
 }
@@ -447,9 +451,26 @@ void check_glb_bytes(std::string_view b, const fs::path& folder) {
 
 // Chunks whose body is a list of chunks (0x4000 after its name). Every chunk's claimed length
 // is checked against its parent's end, iteratively, before Assimp's own walk.
+// The keyframer (0xB000) holds node tags 0xB001..0xB007, which hold tracks.
 bool is_3ds_container(std::uint16_t id) {
   return id == 0x4D4D || id == 0x3D3D || id == 0x4000 || id == 0x4100 || id == 0xAFFF ||
-         id == 0xB000;
+         (id >= 0xB000 && id <= 0xB007);
+}
+
+// Keyframe tracks (0xB020 position ... 0xB029 hide): a 10-byte header, a 32-bit key count,
+// then keys of at least 6 bytes (frame and flags). Assimp reserves the count times 24 bytes
+// before reading a key, so a 150-byte file could ask for 51 GB; the count must fit the chunk.
+void check_3ds_track(std::string_view b, std::size_t at, std::uint64_t length) {
+  constexpr std::uint64_t kHeader = 6 + 10 + 4;
+  constexpr std::uint64_t kSmallestKey = 6;
+  const std::uint64_t keys = length >= kHeader ? le32(b, at + 16) : 0;
+  if (length < kHeader || keys > (length - kHeader) / kSmallestKey) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "%04x", le16(b, at));
+    refuse("keyframe track 0x" + std::string(hex) + " at byte " + std::to_string(at) + " claims " +
+           std::to_string(keys) + " keys in " + std::to_string(length) +
+           " bytes; the file is damaged");
+  }
 }
 
 void check_3ds_bytes(std::string_view b) {
@@ -482,6 +503,7 @@ void check_3ds_bytes(std::string_view b) {
       refuse("chunk 0x" + std::string(hex) + " at byte " + std::to_string(at) + " claims " +
              std::to_string(length) + " bytes, past its parent's end; the file is damaged");
     }
+    if (id >= 0xB020 && id <= 0xB029) check_3ds_track(b, at, length);
     if (!is_3ds_container(id)) {
       at += length;
       continue;
