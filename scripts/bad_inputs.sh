@@ -68,6 +68,8 @@ add garbage.ply mesh "text that is not PLY"
 add short_vertices.3ds mesh "3DS vertex list claiming 9 vertices, with room for 2"
 perl -e 'my $n = 20000; for my $d (0..$n) { print pack("vV", 0x4d4d, 6 * ($n + 1 - $d)) }' >deep.3ds
 add deep.3ds mesh "3DS with 20,000 nested main chunks (120 KB)"
+{ le vV 0x4d4d 38; le vV 0xb000 32; le vV 0xb002 26; le vV 0xb020 20; head -c 10 /dev/zero; le V 2147483647; } >track.3ds
+add track.3ds mesh "3DS keyframe track claiming 2^31 keys in 38 bytes"
 { le vV 0x4d4d 1000; } >past_end.3ds
 add past_end.3ds mesh "3DS main chunk longer than the file"
 gltf_head='{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],'
