@@ -130,12 +130,22 @@ std::string percent_decoded(std::string_view uri, const std::string& where) {
   return out;
 }
 
+constexpr std::size_t kMaxDataUriHeader = 100;
+
 // The decoded size of a base64 data URI. Its characters are checked here because Assimp's
 // decoder leaks the buffer it was filling when it meets a bad one.
 std::uint64_t data_uri_bytes(std::string_view uri, const std::string& where) {
   const std::size_t comma = uri.find(',');
   if (comma == std::string_view::npos || uri.substr(0, comma).find(";base64") == uri.npos) {
     refuse(where + " has a data URI that is not base64 ('data:...;base64,...'); re-export it");
+  }
+  // Assimp's data URI parser keeps the offsets of the media type, parameters and payload in
+  // chars: past 127 they wrap, and it reads before the string.
+  if (comma > kMaxDataUriHeader) {
+    refuse(where + "'s data URI has a header of " + std::to_string(comma) +
+           " characters before "
+           "its ',' (at most " +
+           std::to_string(kMaxDataUriHeader) + " are read); re-export it");
   }
   const std::string_view payload = uri.substr(comma + 1);
   if (payload.size() / 4 * 3 > kMaxDataUriBytes) {
