@@ -483,6 +483,21 @@ void check_3ds_track(std::string_view b, std::size_t at, std::uint64_t length) {
   }
 }
 
+// Vertex (0x4110, 12 bytes each), face (0x4120, 8) and texture coordinate (0x4140, 8) lists:
+// a 16-bit count, then the records. Assimp would stop at the chunk's end with a message that
+// names nothing; this one says which list is short.
+void check_3ds_list(std::string_view b, std::size_t at, std::uint64_t length) {
+  const std::uint16_t id = le16(b, at);
+  const std::uint64_t record = id == 0x4110 ? 12 : 8;
+  const std::uint64_t count = length >= 8 ? le16(b, at + 6) : 0;
+  if (length < 8 || 8 + count * record > length) {
+    const char* what = id == 0x4110 ? "vertex" : id == 0x4120 ? "face" : "texture coordinate";
+    refuse(std::string(what) + " list chunk at byte " + std::to_string(at) + " claims " +
+           std::to_string(count) + " records of " + std::to_string(record) + " bytes in " +
+           std::to_string(length) + " bytes; the file is damaged");
+  }
+}
+
 void check_3ds_bytes(std::string_view b) {
   if (b.size() < 6 || le16(b, 0) != 0x4D4D) {
     refuse("it does not start with a 3DS main chunk (0x4d4d); it is not a 3DS file");
@@ -514,6 +529,7 @@ void check_3ds_bytes(std::string_view b) {
              std::to_string(length) + " bytes, past its parent's end; the file is damaged");
     }
     if (id >= 0xB020 && id <= 0xB029) check_3ds_track(b, at, length);
+    if (id == 0x4110 || id == 0x4120 || id == 0x4140) check_3ds_list(b, at, length);
     if (!is_3ds_container(id)) {
       at += length;
       continue;
