@@ -153,6 +153,69 @@ std::string three_ds(const Mesh& m) {
   return chunk(0x4D4D, chunk(0x3D3D, object));
 }
 
+// glTF 2.0: one mesh (float positions, uint32 indices) under a node with a TRS transform,
+// as JSON with a base64 data URI and as a .glb with a binary chunk.
+std::string gltf_json(const Mesh& m, std::size_t bin_bytes, const std::string& uri) {
+  const std::size_t vbytes = 12 * m.positions.size();
+  std::ostringstream s;
+  s << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],)"
+    << R"("nodes":[{"mesh":0,"translation":[1,2,3],"rotation":[0,0.6,0,0.8],"scale":[2,2,2]}],)"
+    << R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+    << R"("accessors":[{"bufferView":0,"componentType":5126,"type":"VEC3","count":)"
+    << m.positions.size() << R"(},{"bufferView":1,"componentType":5125,"type":"SCALAR","count":)"
+    << 3 * m.triangles.size() << "}],"
+    << R"("bufferViews":[{"buffer":0,"byteLength":)" << vbytes << R"(},{"buffer":0,"byteOffset":)"
+    << vbytes << R"(,"byteLength":)" << 12 * m.triangles.size() << "}],"
+    << R"("buffers":[{"byteLength":)" << bin_bytes
+    << (uri.empty() ? std::string() : R"(,"uri":")" + uri + '"') << "}]}";
+  return s.str();
+}
+
+std::string gltf_bin(const Mesh& m) {
+  std::string bin;
+  for (const auto& p : m.positions) bin.append(reinterpret_cast<const char*>(p.data()), 12);
+  for (const auto& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) put(bin, std::uint32_t(t[k]));
+  }
+  return bin;
+}
+
+std::string base64(const std::string& bytes) {
+  const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    std::uint32_t n = std::uint32_t(std::uint8_t(bytes[i])) << 16;
+    if (i + 1 < bytes.size()) n |= std::uint32_t(std::uint8_t(bytes[i + 1])) << 8;
+    if (i + 2 < bytes.size()) n |= std::uint32_t(std::uint8_t(bytes[i + 2]));
+    out += abc[(n >> 18) & 63];
+    out += abc[(n >> 12) & 63];
+    out += i + 1 < bytes.size() ? abc[(n >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? abc[n & 63] : '=';
+  }
+  return out;
+}
+
+std::string gltf(const Mesh& m) {
+  const std::string bin = gltf_bin(m);
+  return gltf_json(m, bin.size(), "data:application/octet-stream;base64," + base64(bin));
+}
+
+std::string glb(const Mesh& m) {
+  const std::string bin = gltf_bin(m);  // a multiple of 4 bytes
+  std::string text = gltf_json(m, bin.size(), "");
+  while (text.size() % 4 != 0) text += ' ';
+  std::string out;
+  put(out, std::uint32_t(0x46546C67));  // "glTF"
+  put(out, std::uint32_t(2));
+  put(out, std::uint32_t(28 + text.size() + bin.size()));
+  put(out, std::uint32_t(text.size()));
+  put(out, std::uint32_t(0x4E4F534A));  // "JSON"
+  out += text;
+  put(out, std::uint32_t(bin.size()));
+  put(out, std::uint32_t(0x004E4942));  // "BIN"
+  return out + bin;
+}
+
 void mesh_seeds(const fs::path& out, const std::string& name, const Mesh& m) {
   write(out / "mesh_obj" / (name + ".obj"), obj(m));
   write(out / "mesh_off" / (name + ".off"), off(m));
@@ -163,6 +226,8 @@ void mesh_seeds(const fs::path& out, const std::string& name, const Mesh& m) {
   if (m.positions.size() < 65536 && m.triangles.size() < 65536) {
     write(out / "mesh_3ds" / (name + ".3ds"), three_ds(m));
   }
+  write(out / "mesh_gltf" / (name + ".gltf"), gltf(m));
+  write(out / "mesh_glb" / (name + ".glb"), glb(m));
 }
 
 // Nearest-texel downsample of a probe to width x width/2, written by OpenImageIO.

@@ -68,8 +68,21 @@ add garbage.ply mesh "text that is not PLY"
 add short_vertices.3ds mesh "3DS vertex list claiming 9 vertices, with room for 2"
 perl -e 'my $n = 20000; for my $d (0..$n) { print pack("vV", 0x4d4d, 6 * ($n + 1 - $d)) }' >deep.3ds
 add deep.3ds mesh "3DS with 20,000 nested main chunks (120 KB)"
+{ le vV 0x4d4d 38; le vV 0xb000 32; le vV 0xb002 26; le vV 0xb020 20; head -c 10 /dev/zero; le V 2147483647; } >track.3ds
+add track.3ds mesh "3DS keyframe track claiming 2^31 keys in 38 bytes"
 { le vV 0x4d4d 1000; } >past_end.3ds
 add past_end.3ds mesh "3DS main chunk longer than the file"
+gltf_head='{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],'
+printf '%s"accessors":[{"bufferView":0,"componentType":5126,"type":"VEC3","count":4000000000}],"bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}' "$gltf_head" >claims_4e9.gltf
+add claims_4e9.gltf mesh "glTF accessor claiming 4e9 vertices in a 36-byte buffer"
+printf '%s"accessors":[],"bufferViews":[],"buffers":[{"byteLength":36,"uri":"../../etc/passwd"}]}' "$gltf_head" >escape.gltf
+add escape.gltf mesh "glTF buffer URI leaving the file's folder"
+{ printf '{"asset":{"version":"2.0"},"x":'; head -c 100000 /dev/zero | tr '\0' '['; } >deep.gltf
+add deep.gltf mesh "glTF JSON nested 100,000 levels deep"
+printf '%s"skins":[{"joints":[0]}],"accessors":[],"bufferViews":[],"buffers":[]}' "$gltf_head" >skinned.gltf
+add skinned.gltf mesh "glTF with a skin"
+{ printf 'glTF'; le VVVV 2 1000 100 0x4e4f534a; } >short.glb
+add short.glb mesh "GLB whose header claims 1000 bytes, 20 present"
 { head -c 80 /dev/zero; le V 5; head -c 100 /dev/zero; } >short.stl
 add short.stl mesh "binary STL claiming 5 triangles, holding 2"
 
@@ -137,12 +150,14 @@ measure=()
   echo "sizes OpenEXR's buffers (one block of scan lines or one tile past the same limit, an"
   echo "offset table longer than the file) before OpenEXR reads it (\`probes/src/exr_guard.cpp\`)."
   echo
-  echo "Which reader does what: OFF, PLY and 3DS are read by our own strict readers"
-  echo "(\`meshes/src/read_strict.cpp\`, \`meshes/src/read_3ds.cpp\`; OpenMesh's OFF and PLY readers"
-  echo "size buffers from unchecked counts and read values they never set after a parse error,"
-  echo "which no guard in front of them can fix). OBJ and STL still go through OpenMesh: OBJ"
-  echo "behind a strict pre-pass over its face lines, STL behind our own binary/ASCII decision"
-  echo "by file size. Images go through OpenImageIO behind the checks above."
+  echo "Which reader does what: OFF and PLY are read by our own strict readers"
+  echo "(\`meshes/src/read_strict.cpp\`; OpenMesh's OFF and PLY readers size buffers from"
+  echo "unchecked counts and read values they never set after a parse error, which no guard in"
+  echo "front of them can fix). OBJ and STL still go through OpenMesh: OBJ behind a strict"
+  echo "pre-pass over its face lines, STL behind our own binary/ASCII decision by file size."
+  echo "glTF 2.0 and 3DS go through Assimp behind \`meshes/src/asset_guard.cpp\`, which checks"
+  echo "every size, URI and nesting depth Assimp would trust (the table of guards is in"
+  echo "docs/ARCHITECTURE.md, \"Mesh assets\"). Images go through OpenImageIO behind the checks above."
   echo
   echo "The same loaders are fuzzed by \`scripts/fuzz.sh [seconds]\` (libFuzzer, ASan, UBSan;"
   echo "targets in \`fuzz/\`) and the whole test suite runs under ASan, UBSan and LSan with"

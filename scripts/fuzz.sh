@@ -68,11 +68,12 @@ done
 declare -A seeds=(
   [fuzz_prtx]=prtx [fuzz_prtx_resealed]=prtx [fuzz_prtc]=prtc [fuzz_prtc_resealed]=prtc
   [fuzz_mesh_obj]=mesh_obj [fuzz_mesh_ply]=mesh_ply [fuzz_mesh_off]=mesh_off
-  [fuzz_mesh_stl]=mesh_stl [fuzz_mesh_3ds]=mesh_3ds
+  [fuzz_mesh_stl]=mesh_stl [fuzz_mesh_3ds]=mesh_3ds [fuzz_mesh_gltf]=mesh_gltf [fuzz_mesh_glb]=mesh_glb
   [fuzz_probe_hdr]=probe_hdr [fuzz_probe_exr]=probe_exr
 )
 targets=(fuzz_prtx fuzz_prtx_resealed fuzz_prtc fuzz_prtc_resealed fuzz_mesh_obj fuzz_mesh_ply
-         fuzz_mesh_off fuzz_mesh_stl fuzz_mesh_3ds fuzz_probe_hdr fuzz_probe_exr)
+         fuzz_mesh_off fuzz_mesh_stl fuzz_mesh_3ds fuzz_mesh_gltf fuzz_mesh_glb fuzz_probe_hdr
+         fuzz_probe_exr)
 # PRTR_FUZZ_SKIP: targets to leave out (names separated by spaces), e.g. one with an open
 # finding that is being fixed; each is named in the output, so a skip is never silent.
 if [[ -n ${PRTR_FUZZ_SKIP:-} ]]; then

@@ -929,6 +929,12 @@ TEST(LoadErrors, DamagedThreeDsChunks) {
   truncated.resize(truncated.size() - 10);  // the face list claims more than is there
   expect_load_error(write_file("truncated.3ds", truncated), "damaged");
   expect_load_error(write_file("notthreeds.3ds", "hello, not a 3ds file"), "not a 3DS file");
+  // A vertex list claiming more records than its chunk holds, chunk lengths all consistent.
+  std::string short_list = quad_3ds();
+  const std::size_t count_at = short_list.find(std::string("\x10\x41", 2)) + 6;
+  short_list[count_at] = 9;
+  expect_load_error(write_file("short_list.3ds", short_list),
+                    "vertex list chunk at byte 29 claims 9 records of 12 bytes in 56 bytes");
 }
 
 TEST(Load, GlmarkHorse) {

@@ -96,8 +96,9 @@ std::string chunk(std::uint16_t id, const std::string& body) {
   return bytes_of(id) + bytes_of(std::uint32_t(6 + body.size())) + body;
 }
 
-TEST(Hostile3ds, DeepNestingNeitherRecursesNorFails) {
-  // A quad inside 20,000 nested editor chunks: the recursive walk overflowed the stack.
+TEST(Hostile3ds, DeepNestingIsRefusedWithoutRecursion) {
+  // A quad inside 20,000 nested editor chunks overflowed the stack of a recursive walk. The
+  // guard in front of Assimp walks chunks with its own stack and refuses past 32 levels.
   std::string vertices = bytes_of(std::uint16_t(4));
   const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
   for (const auto& v : p) vertices += std::string(reinterpret_cast<const char*>(v), 12);
@@ -120,16 +121,45 @@ TEST(Hostile3ds, DeepNestingNeitherRecursesNorFails) {
   }
   const fs::path deep = write_file("deep.3ds", file + nested);
   EXPECT_GT(fs::file_size(deep), 120000u);
-  meshes::LoadReport report;
-  const meshes::Mesh m = meshes::load_mesh(deep, {}, &report);
-  EXPECT_EQ(m.triangle_count(), 2u);
+  expect_mesh_error(deep, "nest deeper than 32 levels");
 
-  // The same depth of main chunks with nothing inside: an error, not a crash.
+  // The same depth of main chunks with nothing inside.
   std::string empty;
   for (std::uint32_t d = 0; d <= kLevels; ++d) {
     empty += bytes_of(std::uint16_t(0x4D4D)) + bytes_of(std::uint32_t(6 * (kLevels + 1 - d)));
   }
-  expect_mesh_error(write_file("deep_empty.3ds", empty), "no vertices and no faces");
+  expect_mesh_error(write_file("deep_empty.3ds", empty), "nest deeper than 32 levels");
+
+  // At a depth real files have (main, editor, object, mesh) the quad loads.
+  const std::string shallow = chunk(0x4D4D, chunk(0x3D3D, nested));
+  EXPECT_EQ(meshes::load_mesh(write_file("shallow.3ds", shallow)).triangle_count(), 2u);
+}
+
+TEST(Hostile3ds, KeyframeTrackCountMustFitItsChunk) {
+  // Assimp reserves 24 bytes per key a position track claims before reading any: 2^31 keys
+  // in a 150-byte file asked for 51 GB.
+  std::string vertices = bytes_of(std::uint16_t(4));
+  const float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (const auto& v : p) vertices += std::string(reinterpret_cast<const char*>(v), 12);
+  std::string faces = bytes_of(std::uint16_t(2));
+  for (int t = 0; t < 2; ++t) {
+    const std::uint16_t idx[4] = {0, std::uint16_t(1 + t), std::uint16_t(2 + t), 0};
+    faces += std::string(reinterpret_cast<const char*>(idx), 8);
+  }
+  const std::string object =
+      chunk(0x4000, std::string("quad\0", 5) +
+                        chunk(0x4100, chunk(0x4110, vertices) + chunk(0x4120, faces)));
+  const auto with_track = [&](std::uint32_t keys, const std::string& key_bytes) {
+    const std::string name = chunk(0xB010, std::string("quad\0", 5) + std::string(6, '\0'));
+    const std::string track = chunk(0xB020, std::string(10, '\0') + bytes_of(keys) + key_bytes);
+    return chunk(0x4D4D, chunk(0x3D3D, object) + chunk(0xB000, chunk(0xB002, name + track)));
+  };
+  expect_mesh_error(write_file("track_2g.3ds", with_track(0x7FFFFFFF, "")),
+                    "claims 2147483647 keys");
+  // One real key (frame, flags, x y z) fits and loads.
+  const std::string key =
+      bytes_of(std::uint32_t(0)) + bytes_of(std::uint16_t(0)) + std::string(12, '\0');
+  EXPECT_EQ(meshes::load_mesh(write_file("track_1.3ds", with_track(1, key))).triangle_count(), 2u);
 }
 
 // --- OFF ----------------------------------------------------------------------------------

@@ -1,10 +1,12 @@
-// meshes/load.cpp: OBJ and STL through OpenMesh's IO layer, OFF, PLY and 3DS through our own
-// readers, then clean-up (weld, drop degenerate and unreferenced, frames).
+// meshes/load.cpp: OBJ and STL through OpenMesh's IO layer, OFF and PLY through our own
+// readers, glTF 2.0 and 3DS through Assimp behind our guards, then clean-up (weld, drop
+// degenerate and unreferenced, frames).
 //
 // OpenMesh's OFF and PLY readers size buffers from unchecked header counts and read values
 // they never set after a parse error (see read_strict.h), which no guard in front of them can
 // fix; they are replaced. Its OBJ reader is kept behind a strict pre-pass over face lines,
-// and its STL reader behind our own binary/ASCII decision by file size.
+// and its STL reader behind our own binary/ASCII decision by file size. Assimp is kept
+// behind the checks of asset_guard.h, which bound every size it would trust.
 //
 // OpenMesh is used only for parsing. Its readers feed a BaseImporter; OpenMesh's own
 // ImporterT builds a halfedge mesh, which cannot hold non-manifold ("complex") faces: it
@@ -13,21 +15,18 @@
 // face the reader delivers reaches the clean-up and is counted in LoadReport. (On the Stanford
 // bunny OpenMesh 9's PolyMesh happens to keep all 69,666 faces; non-manifold inputs such as
 // the "fin" in meshes_test would not survive it unchanged.)
-//
-// Welding uses a uniform hash grid with cells as large as the weld distance: two points
-// within that distance lie in the same or in neighbouring cells, so each vertex checks the
-// 27 cells around it. Vertices are visited in index order and each merges into the lowest
-// index within reach, so the result does not depend on hash-table order.
 #include "meshes/load.h"
 
-#include "read_3ds.h"
+#include "meshes/weld.h"
+
+#include "asset_guard.h"
+#include "read_assimp.h"
 #include "read_strict.h"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -37,7 +36,6 @@
 #include <sstream>
 #include <string_view>
 #include <system_error>
-#include <unordered_map>
 #include <vector>
 
 namespace meshes {
@@ -51,11 +49,7 @@ namespace omio = OpenMesh::IO;
 // is a sliver of float rounding, with no usable normal.
 constexpr double kDegenerateAreaRatio = 1e-12;
 
-// Below this relative tolerance the weld distance is under float resolution for coordinates
-// of the size of the mesh, and grid cell coordinates could overflow; weld exact matches only.
-constexpr double kSmallestGridTolerance = 1e-15;
-
-constexpr std::array<const char*, 5> kFormats = {"obj", "ply", "off", "stl", "3ds"};
+constexpr std::array<const char*, 7> kFormats = {"obj", "ply", "off", "stl", "3ds", "gltf", "glb"};
 
 std::string supported_list() {
   std::string out;
@@ -209,83 +203,6 @@ bool is_binary_stl(const fs::path& path, std::uintmax_t size, std::string& probl
   return false;
 }
 
-// --- Welding -----------------------------------------------------------------------------------
-
-struct CellKey {
-  std::int64_t x, y, z;
-  bool operator==(const CellKey&) const = default;
-};
-
-struct CellHash {
-  std::size_t operator()(const CellKey& k) const {
-    // splitmix64 finaliser over a combination of the three coordinates.
-    std::uint64_t h = static_cast<std::uint64_t>(k.x) * 0x9E3779B97F4A7C15ull;
-    h ^= static_cast<std::uint64_t>(k.y) + 0x632BE59BD9B4E019ull + (h << 6) + (h >> 2);
-    h ^= static_cast<std::uint64_t>(k.z) + 0x8CB92BA72F3D8DD7ull + (h << 6) + (h >> 2);
-    h ^= h >> 30;
-    h *= 0xBF58476D1CE4E5B9ull;
-    h ^= h >> 27;
-    h *= 0x94D049BB133111EBull;
-    h ^= h >> 31;
-    return static_cast<std::size_t>(h);
-  }
-};
-
-// remap[v] = the vertex v merges into (v itself when it survives).
-std::vector<std::uint32_t> weld_map(const std::vector<Vec3>& positions, double tolerance,
-                                    const Bounds& box) {
-  const std::size_t n = positions.size();
-  std::vector<std::uint32_t> remap(n);
-  for (std::size_t v = 0; v < n; ++v) remap[v] = static_cast<std::uint32_t>(v);
-  if (tolerance < 0.0 || n == 0) return remap;
-
-  const double diagonal = diagonal_of(box);
-  const double eps = tolerance * diagonal;
-  if (!(tolerance >= kSmallestGridTolerance) || !(eps > 0.0)) {
-    // Exact matches only (+0 and -0 are the same point).
-    std::unordered_map<CellKey, std::uint32_t, CellHash> first;
-    first.reserve(n);
-    for (std::size_t v = 0; v < n; ++v) {
-      const Vec3& p = positions[v];
-      const CellKey key{std::bit_cast<std::int32_t>(p.x() + 0.f),
-                        std::bit_cast<std::int32_t>(p.y() + 0.f),
-                        std::bit_cast<std::int32_t>(p.z() + 0.f)};
-      const auto [it, inserted] = first.try_emplace(key, static_cast<std::uint32_t>(v));
-      if (!inserted) remap[v] = it->second;
-    }
-    return remap;
-  }
-
-  const Eigen::Vector3d origin = box.min.cast<double>();
-  const double eps2 = eps * eps;
-  std::unordered_map<CellKey, std::vector<std::uint32_t>, CellHash> grid;
-  grid.reserve(n);
-  for (std::size_t v = 0; v < n; ++v) {
-    const Eigen::Vector3d p = positions[v].cast<double>();
-    const Eigen::Vector3d c = ((p - origin) / eps).array().floor();
-    const CellKey cell{static_cast<std::int64_t>(c.x()), static_cast<std::int64_t>(c.y()),
-                       static_cast<std::int64_t>(c.z())};
-    std::uint32_t best = static_cast<std::uint32_t>(v);
-    for (std::int64_t dx = -1; dx <= 1; ++dx) {
-      for (std::int64_t dy = -1; dy <= 1; ++dy) {
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          const auto it = grid.find({cell.x + dx, cell.y + dy, cell.z + dz});
-          if (it == grid.end()) continue;
-          for (std::uint32_t r : it->second) {
-            if (r < best && (positions[r].cast<double>() - p).squaredNorm() <= eps2) best = r;
-          }
-        }
-      }
-    }
-    if (best == v) {
-      grid[cell].push_back(best);
-    } else {
-      remap[v] = best;
-    }
-  }
-  return remap;
-}
-
 // --- Clean-up ----------------------------------------------------------------------------------
 
 struct CleanCounts {
@@ -417,23 +334,16 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
            CollectingImporter& importer, const Fail& fail) {
   const std::lock_guard<std::mutex> lock(reader_mutex());
   omio::Options opt;
-  if (format == "3ds") {
-    detail::Raw3ds raw;
-    const std::string problem = detail::read_3ds(path, raw);
-    if (!problem.empty()) throw fail(problem);
-    for (const Vec3& p : raw.positions) importer.positions.push_back(p);
-    for (std::size_t c = 0; c < raw.corners.size(); c += 3) {
-      for (std::size_t k = 0; k < 3; ++k) {
-        const std::uint32_t index = raw.corners[c + k];
-        if (index >= importer.positions.size() && !importer.has_bad_face) {
-          importer.has_bad_face = true;
-          importer.bad_face = importer.face_count();
-          importer.bad_index = index;
-        }
-        importer.corners.push_back(index < importer.positions.size() ? index : 0);
-      }
-      importer.face_offsets.push_back(importer.corners.size());
+  if (format == "3ds" || format == "gltf" || format == "glb") {
+    const std::string refused = format == "3ds"   ? detail::check_3ds(path, size)
+                                : format == "glb" ? detail::check_glb(path, size)
+                                                  : detail::check_gltf(path, size);
+    if (!refused.empty()) throw fail(refused);
+    detail::RawPolygons raw;
+    if (const std::string problem = detail::read_assimp(path, raw); !problem.empty()) {
+      throw fail(problem);
     }
+    deliver(raw, importer);
     return true;
   }
   if (format == "off" || format == "ply") {
@@ -465,6 +375,113 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
   return omio::IOManager().read(path.string(), importer, opt);
 }
 
+// File-system problems first, each with its own fix; returns the lower-case format.
+template <class Fail>
+std::string check_source(const fs::path& path, const Fail& fail) {
+  std::error_code ec;
+  const fs::file_status status = fs::status(path, ec);
+  if (ec && ec != std::errc::no_such_file_or_directory) {
+    throw fail("cannot be inspected (" + ec.message() + "); check the path and permissions");
+  }
+  if (!fs::exists(status)) {
+    throw fail("no such file; check the path (relative paths start at " +
+               fs::current_path(ec).string() + ")");
+  }
+  if (fs::is_directory(status)) {
+    throw fail("is a directory, not a mesh file; name a " + supported_list() + " file inside it");
+  }
+  const std::string extension = path.extension().string();
+  const std::string format = lower(extension.empty() ? extension : extension.substr(1));
+  if (std::find(kFormats.begin(), kFormats.end(), format) == kFormats.end()) {
+    throw fail("unknown mesh format (" +
+               (extension.empty() ? std::string("no extension") : "'" + extension + "'") +
+               "); supported extensions are " + supported_list() +
+               " (rename the file if it is one of these, or convert it, e.g. with meshlab)");
+  }
+  return format;
+}
+
+// Parses into `importer`. Memory use is bounded by the file's size (every reader checks counts
+// against the bytes that are left), so running out of memory here means the file itself is
+// too large.
+template <class Fail>
+void parse_checked(const fs::path& path, const std::string& format, CollectingImporter& importer,
+                   const Fail& fail) {
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
+  if (size == 0) throw fail("the file is empty (0 bytes); re-export the mesh");
+  if (!std::ifstream(path, std::ios::binary)) {
+    throw fail("cannot be opened for reading; check its permissions");
+  }
+  bool parsed = false;
+  try {
+    parsed = parse(path, format, size, importer, fail);
+  } catch (const std::bad_alloc&) {
+    throw fail("too large to load into memory (" + std::to_string(size) +
+               " bytes); free memory or simplify the mesh");
+  } catch (const std::length_error&) {
+    throw fail("too large to load into memory (" + std::to_string(size) +
+               " bytes); free memory or simplify the mesh");
+  }
+  if (!parsed) {
+    throw fail("could not parse this file as " + upper(format) + "; check that it is a valid ." +
+               format + " file (re-export it if unsure)");
+  }
+}
+
+// What the reader delivered must name existing, finite vertices and hold faces.
+template <class Fail>
+void check_parsed(const CollectingImporter& importer, const std::string& format, const Fail& fail) {
+  if (importer.has_bad_face) {
+    std::ostringstream msg;
+    msg << "face " << importer.bad_face << " (0-based, in file order) refers to vertex "
+        << importer.bad_index << ", which does not exist (the reader found "
+        << importer.positions.size()
+        << " vertices); a vertex line may be malformed (OpenMesh's text readers skip "
+           "coordinates they cannot parse, such as 'nan' or 'inf'); fix the file";
+    throw fail(msg.str());
+  }
+  if (importer.positions.empty() && importer.face_count() == 0) {
+    throw fail("no vertices and no faces found; check that this is really a ." + format +
+               " mesh file (the " + upper(format) + " reader skips " +
+               (format == "obj" || format == "stl" ? "lines" : "records") + " it does not know)");
+  }
+  if (importer.face_count() == 0) {
+    throw fail("the file has no faces, only " + std::to_string(importer.positions.size()) +
+               " vertices; a point cloud cannot be baked, export the surface with its faces");
+  }
+  for (std::size_t v = 0; v < importer.positions.size(); ++v) {
+    if (!importer.positions[v].allFinite()) {
+      throw fail("vertex " + std::to_string(v) +
+                 " (0-based, in file order) has a non-finite coordinate " +
+                 describe(importer.positions[v]) + "; fix or remove it");
+    }
+  }
+}
+
+// Fan-triangulates: corners c0 ... c(k-1) give (c0, ci, ci+1). A face with fewer than three
+// corners has no area and counts as one degenerate triangle (returned).
+std::size_t triangulate(CollectingImporter& importer, Mesh& mesh, LoadReport& report) {
+  report.file_vertices = importer.positions.size();
+  report.file_faces = importer.face_count();
+  mesh.positions = std::move(importer.positions);
+  std::size_t short_faces = 0;
+  for (std::size_t f = 0; f < importer.face_count(); ++f) {
+    const std::size_t begin = importer.face_offsets[f];
+    const std::size_t k = importer.face_offsets[f + 1] - begin;
+    if (k < 3) {
+      ++short_faces;
+      continue;
+    }
+    if (k > 3) ++report.polygons_triangulated;
+    const std::uint32_t* c = importer.corners.data() + begin;
+    for (std::size_t i = 1; i + 1 < k; ++i) mesh.triangles.push_back({c[0], c[i], c[i + 1]});
+  }
+  report.triangles_after_triangulation = mesh.triangles.size() + short_faces;
+  return short_faces;
+}
+
 }  // namespace
 
 void clean_mesh(Mesh& mesh, const LoadOptions& options, LoadReport* report) {
@@ -489,102 +506,16 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
   const auto fail = [&](const std::string& problem) -> MeshError {
     return MeshError(name + ": " + problem);
   };
-
-  // File-system problems first, each with its own fix.
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw fail("cannot be inspected (" + ec.message() + "); check the path and permissions");
-  }
-  if (!fs::exists(status)) {
-    throw fail("no such file; check the path (relative paths start at " +
-               fs::current_path(ec).string() + ")");
-  }
-  if (fs::is_directory(status)) {
-    throw fail("is a directory, not a mesh file; name a " + supported_list() + " file inside it");
-  }
-  const std::string extension = path.extension().string();
-  const std::string format = lower(extension.empty() ? extension : extension.substr(1));
-  if (std::find(kFormats.begin(), kFormats.end(), format) == kFormats.end()) {
-    throw fail("unknown mesh format (" +
-               (extension.empty() ? std::string("no extension") : "'" + extension + "'") +
-               "); supported extensions are " + supported_list() +
-               " (rename the file if it is one of these, or convert it, e.g. with meshlab)");
-  }
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
-  if (size == 0) throw fail("the file is empty (0 bytes); re-export the mesh");
-  if (!std::ifstream(path, std::ios::binary)) {
-    throw fail("cannot be opened for reading; check its permissions");
-  }
-
-  // Parse. Memory use is bounded by the file's size (every reader checks counts against the
-  // bytes that are left), so running out of memory here means the file itself is too large.
+  const std::string format = check_source(path, fail);
   CollectingImporter importer;
-  bool parsed = false;
-  try {
-    parsed = parse(path, format, size, importer, fail);
-  } catch (const std::bad_alloc&) {
-    throw fail("too large to load into memory (" + std::to_string(size) +
-               " bytes); free memory or simplify the mesh");
-  } catch (const std::length_error&) {
-    throw fail("too large to load into memory (" + std::to_string(size) +
-               " bytes); free memory or simplify the mesh");
-  }
-  if (!parsed) {
-    throw fail("could not parse this file as " + upper(format) + "; check that it is a valid ." +
-               format + " file (re-export it if unsure)");
-  }
-  if (importer.has_bad_face) {
-    std::ostringstream msg;
-    msg << "face " << importer.bad_face << " (0-based, in file order) refers to vertex "
-        << importer.bad_index << ", which does not exist (the reader found "
-        << importer.positions.size()
-        << " vertices); a vertex line may be malformed (OpenMesh's text readers skip "
-           "coordinates they cannot parse, such as 'nan' or 'inf'); fix the file";
-    throw fail(msg.str());
-  }
-  if (importer.positions.empty() && importer.face_count() == 0) {
-    throw fail("no vertices and no faces found; check that this is really a ." + format +
-               " mesh file (the " + upper(format) + " reader skips " +
-               (format == "3ds" ? "chunks" : "lines") + " it does not know)");
-  }
-  if (importer.face_count() == 0) {
-    throw fail("the file has no faces, only " + std::to_string(importer.positions.size()) +
-               " vertices; a point cloud cannot be baked, export the surface with its faces");
-  }
-  for (std::size_t v = 0; v < importer.positions.size(); ++v) {
-    if (!importer.positions[v].allFinite()) {
-      throw fail("vertex " + std::to_string(v) +
-                 " (0-based, in file order) has a non-finite "
-                 "coordinate " +
-                 describe(importer.positions[v]) + "; fix or remove it");
-    }
-  }
+  parse_checked(path, format, importer, fail);
+  check_parsed(importer, format, fail);
 
-  // Fan-triangulate: corners c0 ... c(k-1) give (c0, ci, ci+1). A face with fewer than three
-  // corners has no area and counts as one degenerate triangle.
   LoadReport local;
   local.path = name;
   local.format = format;
-  local.file_vertices = importer.positions.size();
-  local.file_faces = importer.face_count();
   Mesh mesh;
-  mesh.positions = std::move(importer.positions);
-  std::size_t short_faces = 0;
-  for (std::size_t f = 0; f < importer.face_count(); ++f) {
-    const std::size_t begin = importer.face_offsets[f];
-    const std::size_t k = importer.face_offsets[f + 1] - begin;
-    if (k < 3) {
-      ++short_faces;
-      continue;
-    }
-    if (k > 3) ++local.polygons_triangulated;
-    const std::uint32_t* c = importer.corners.data() + begin;
-    for (std::size_t i = 1; i + 1 < k; ++i) mesh.triangles.push_back({c[0], c[i], c[i + 1]});
-  }
-  local.triangles_after_triangulation = mesh.triangles.size() + short_faces;
-
+  const std::size_t short_faces = triangulate(importer, mesh, local);
   const CleanCounts counts = clean(mesh, options, name);
   local.degenerate_faces_dropped = counts.degenerate + short_faces;
   local.vertices_welded = counts.welded;

@@ -103,22 +103,32 @@ constexpr std::uint64_t kMaxIndexable = std::numeric_limits<std::uint32_t>::max(
 
 // --- OFF ------------------------------------------------------------------------------------
 
-std::string read_off(std::string_view bytes, RawPolygons& out) {
-  Lines lines(bytes);
-  std::string_view line;
-  // The next line with content, comments ('#' to the end of the line) removed.
-  const auto next_record = [&](std::vector<std::string_view>& tokens) {
-    while (lines.next(line)) {
+namespace {
+
+// Records of an OFF file: lines with content, comments ('#' to the end of the line) removed.
+class OffRecords {
+ public:
+  explicit OffRecords(std::string_view bytes) : lines_(bytes) {}
+  bool next(std::vector<std::string_view>& tokens) {
+    std::string_view line;
+    while (lines_.next(line)) {
       const std::size_t hash = line.find('#');
       tokens = split(hash == std::string_view::npos ? line : line.substr(0, hash));
       if (!tokens.empty()) return true;
     }
     return false;
-  };
-  const auto at_line = [&] { return "line " + std::to_string(lines.number()) + ": "; };
+  }
+  std::string at_line() const { return "line " + std::to_string(lines_.number()) + ": "; }
+  std::size_t remaining() const { return lines_.remaining(); }
 
+ private:
+  Lines lines_;
+};
+
+// The header and the counts, checked against the bytes that follow.
+std::string read_off_header(OffRecords& records, std::uint64_t& nv, std::uint64_t& nf) {
   std::vector<std::string_view> tokens;
-  if (!next_record(tokens)) return "no OFF header (the file holds only blank lines or comments)";
+  if (!records.next(tokens)) return "no OFF header (the file holds only blank lines or comments)";
   // [ST][C][N][4][n]OFF: the prefixes add per-vertex values after x y z, which are skipped.
   const std::string_view keyword = tokens.front();
   if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") {
@@ -134,70 +144,90 @@ std::string read_off(std::string_view bytes, RawPolygons& out) {
     return "binary OFF is not read; convert the file to ASCII OFF or to PLY";
   }
   // The counts may share the header's line.
-  if (tokens.empty() && !next_record(tokens)) return "the file ends before the element counts";
-  if (tokens.size() < 2) return at_line() + "expected 'vertices faces [edges]' counts";
-  const auto nv = parse_int<std::uint64_t>(tokens[0]);
-  const auto nf = parse_int<std::uint64_t>(tokens[1]);
-  if (!nv || !nf) {
-    return at_line() + "the counts " + quote(tokens[0]) + " " + quote(tokens[1]) +
+  if (tokens.empty() && !records.next(tokens)) return "the file ends before the element counts";
+  if (tokens.size() < 2) return records.at_line() + "expected 'vertices faces [edges]' counts";
+  const auto v = parse_int<std::uint64_t>(tokens[0]);
+  const auto f = parse_int<std::uint64_t>(tokens[1]);
+  if (!v || !f) {
+    return records.at_line() + "the counts " + quote(tokens[0]) + " " + quote(tokens[1]) +
            " are not non-negative integers";
   }
+  nv = *v;
+  nf = *f;
   // The shortest vertex line is "0 0 0\n" (6 bytes), the shortest face "0\n" (2 bytes): a
   // header claiming more than the rest of the file can hold is damaged, and is refused before
   // anything is sized from it.
-  const std::uint64_t left = lines.remaining();
-  if (*nv > kMaxIndexable || *nf > kMaxIndexable || *nv > left / 6 || *nf > (left - 6 * *nv) / 2) {
-    return "the header claims " + std::to_string(*nv) + " vertices and " + std::to_string(*nf) +
+  const std::uint64_t left = records.remaining();
+  if (nv > kMaxIndexable || nf > kMaxIndexable || nv > left / 6 || nf > (left - 6 * nv) / 2) {
+    return "the header claims " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
            " faces, but only " + std::to_string(left) +
            " bytes follow it (at least 6 per vertex and 2 per face are needed); the header is "
            "wrong or the file is truncated";
   }
-  out.positions.reserve(*nv);
-  out.face_offsets.reserve(*nf + 1);
+  return {};
+}
 
-  for (std::uint64_t v = 0; v < *nv; ++v) {
-    if (!next_record(tokens)) {
-      return "the file ends after " + std::to_string(v) + " of the " + std::to_string(*nv) +
+std::string read_off_vertices(OffRecords& records, std::uint64_t nv, RawPolygons& out) {
+  std::vector<std::string_view> tokens;
+  out.positions.reserve(nv);
+  for (std::uint64_t v = 0; v < nv; ++v) {
+    if (!records.next(tokens)) {
+      return "the file ends after " + std::to_string(v) + " of the " + std::to_string(nv) +
              " vertices its header claims; the file is truncated or the header is wrong";
     }
-    if (tokens.size() < 3) return at_line() + "vertex " + std::to_string(v) + " has no x y z";
+    if (tokens.size() < 3) {
+      return records.at_line() + "vertex " + std::to_string(v) + " has no x y z";
+    }
     double p[3];
     for (int k = 0; k < 3; ++k) {
       const auto x = parse_real(tokens[std::size_t(k)]);
       if (!x) {
-        return at_line() + "vertex " + std::to_string(v) + ": " + quote(tokens[std::size_t(k)]) +
-               " is not a number";
+        return records.at_line() + "vertex " + std::to_string(v) + ": " +
+               quote(tokens[std::size_t(k)]) + " is not a number";
       }
       p[k] = *x;
     }
     out.positions.emplace_back(float(p[0]), float(p[1]), float(p[2]));
   }
-  for (std::uint64_t f = 0; f < *nf; ++f) {
-    if (!next_record(tokens)) {
-      return "the file ends after " + std::to_string(f) + " of the " + std::to_string(*nf) +
+  return {};
+}
+
+std::string read_off_faces(OffRecords& records, std::uint64_t nf, RawPolygons& out) {
+  std::vector<std::string_view> tokens;
+  out.face_offsets.reserve(nf + 1);
+  for (std::uint64_t f = 0; f < nf; ++f) {
+    if (!records.next(tokens)) {
+      return "the file ends after " + std::to_string(f) + " of the " + std::to_string(nf) +
              " faces its header claims; the file is truncated or the header is wrong";
     }
+    const std::string where = records.at_line() + "face " + std::to_string(f);
     const auto k = parse_int<std::uint64_t>(tokens[0]);
     if (!k) {
-      return at_line() + "face " + std::to_string(f) + ": the corner count " + quote(tokens[0]) +
-             " is not a non-negative integer";
+      return where + ": the corner count " + quote(tokens[0]) + " is not a non-negative integer";
     }
     // Anything after the corners (a colour) is allowed and skipped.
     if (*k > tokens.size() - 1) {
-      return at_line() + "face " + std::to_string(f) + " claims " + std::to_string(*k) +
-             " corners but its line lists " + std::to_string(tokens.size() - 1) + " values";
+      return where + " claims " + std::to_string(*k) + " corners but its line lists " +
+             std::to_string(tokens.size() - 1) + " values";
     }
     for (std::size_t c = 1; c <= *k; ++c) {
       const auto index = parse_int<std::int64_t>(tokens[c]);
-      if (!index) {
-        return at_line() + "face " + std::to_string(f) + ": " + quote(tokens[c]) +
-               " is not a vertex index";
-      }
+      if (!index) return where + ": " + quote(tokens[c]) + " is not a vertex index";
       out.corners.push_back(*index);
     }
     out.face_offsets.push_back(out.corners.size());
   }
   return {};
+}
+
+}  // namespace
+
+std::string read_off(std::string_view bytes, RawPolygons& out) {
+  OffRecords records(bytes);
+  std::uint64_t nv = 0, nf = 0;
+  if (std::string problem = read_off_header(records, nv, nf); !problem.empty()) return problem;
+  if (std::string problem = read_off_vertices(records, nv, out); !problem.empty()) return problem;
+  return read_off_faces(records, nf, out);
 }
 
 // --- PLY ------------------------------------------------------------------------------------
@@ -336,64 +366,74 @@ class Values {
 
 }  // namespace
 
-std::string read_ply(std::string_view bytes, RawPolygons& out) {
-  Lines lines(bytes);
+namespace {
+
+// One header line after 'ply': a format, element or property declaration.
+std::string read_ply_header_line(const std::vector<std::string_view>& t,
+                                 std::optional<Format>& format, std::vector<Element>& elements) {
+  if (t[0] == "format") {
+    if (t.size() < 2) return "'format' names no encoding";
+    if (t[1] == "ascii") {
+      format = Format::kAscii;
+    } else if (t[1] == "binary_little_endian") {
+      format = Format::kLittle;
+    } else if (t[1] == "binary_big_endian") {
+      format = Format::kBig;
+    } else {
+      return "unknown encoding " + quote(t[1]);
+    }
+  } else if (t[0] == "element") {
+    if (t.size() != 3) return "expected 'element <name> <count>'";
+    const auto count = parse_int<std::uint64_t>(t[2]);
+    if (!count) return "the count " + quote(t[2]) + " is not a non-negative integer";
+    elements.push_back({std::string(t[1]), *count, {}});
+  } else if (t[0] == "property") {
+    if (elements.empty()) return "a property before any element";
+    Property p;
+    if (t.size() == 5 && t[1] == "list") {
+      const auto count_type = scalar_of(t[2]);
+      const auto item_type = scalar_of(t[3]);
+      if (!count_type || !item_type || !is_integer(*count_type)) {
+        return "unknown list types " + quote(t[2]) + " " + quote(t[3]);
+      }
+      p = {std::string(t[4]), *item_type, true, *count_type};
+    } else if (t.size() == 3) {
+      const auto type = scalar_of(t[1]);
+      if (!type) return "unknown type " + quote(t[1]);
+      p = {std::string(t[2]), *type, false, Scalar::kUint8};
+    } else {
+      return "expected 'property <type> <name>' or 'property list ...'";
+    }
+    elements.back().properties.push_back(p);
+  } else {
+    return "unknown keyword " + quote(t[0]);
+  }
+  return {};
+}
+
+std::string read_ply_header(Lines& lines, std::optional<Format>& format,
+                            std::vector<Element>& elements) {
   std::string_view line;
   if (!lines.next(line) || trim(line) != "ply") return "it does not start with the line 'ply'";
-  std::optional<Format> format;
-  std::vector<Element> elements;
-  bool ended = false;
-  while (!ended && lines.next(line)) {
-    const auto at_line = [&] { return "header line " + std::to_string(lines.number()) + ": "; };
+  while (lines.next(line)) {
     const std::vector<std::string_view> t = split(line);
     if (t.empty() || t[0] == "comment" || t[0] == "obj_info") continue;
     if (t[0] == "end_header") {
-      ended = true;
-    } else if (t[0] == "format") {
-      if (t.size() < 2) return at_line() + "'format' names no encoding";
-      if (t[1] == "ascii") {
-        format = Format::kAscii;
-      } else if (t[1] == "binary_little_endian") {
-        format = Format::kLittle;
-      } else if (t[1] == "binary_big_endian") {
-        format = Format::kBig;
-      } else {
-        return at_line() + "unknown encoding " + quote(t[1]);
-      }
-    } else if (t[0] == "element") {
-      if (t.size() != 3) return at_line() + "expected 'element <name> <count>'";
-      const auto count = parse_int<std::uint64_t>(t[2]);
-      if (!count) return at_line() + "the count " + quote(t[2]) + " is not a non-negative integer";
-      elements.push_back({std::string(t[1]), *count, {}});
-    } else if (t[0] == "property") {
-      if (elements.empty()) return at_line() + "a property before any element";
-      Property p;
-      if (t.size() == 5 && t[1] == "list") {
-        const auto count_type = scalar_of(t[2]);
-        const auto item_type = scalar_of(t[3]);
-        if (!count_type || !item_type || !is_integer(*count_type)) {
-          return at_line() + "unknown list types " + quote(t[2]) + " " + quote(t[3]);
-        }
-        p = {std::string(t[4]), *item_type, true, *count_type};
-      } else if (t.size() == 3) {
-        const auto type = scalar_of(t[1]);
-        if (!type) return at_line() + "unknown type " + quote(t[1]);
-        p = {std::string(t[2]), *type, false, Scalar::kUint8};
-      } else {
-        return at_line() + "expected 'property <type> <name>' or 'property list ...'";
-      }
-      elements.back().properties.push_back(p);
-    } else {
-      return at_line() + "unknown keyword " + quote(t[0]);
+      if (!format) return "the header has no 'format' line";
+      return {};
+    }
+    if (std::string problem = read_ply_header_line(t, format, elements); !problem.empty()) {
+      return "header line " + std::to_string(lines.number()) + ": " + problem;
     }
   }
-  if (!ended) return "the header has no 'end_header' line";
-  if (!format) return "the header has no 'format' line";
+  return "the header has no 'end_header' line";
+}
 
-  // Every record takes at least one byte per scalar (binary) or two characters per value
-  // (text): counts the rest of the file cannot hold are refused before any allocation, and a
-  // record can never take zero bytes, so time is bounded by the file size too.
-  const std::uint64_t left = lines.remaining();
+// Every record takes at least one byte per scalar (binary) or two characters per value
+// (text): counts the rest of the file cannot hold are refused before any allocation, and a
+// record can never take zero bytes, so time is bounded by the file size too.
+std::string check_ply_counts(const std::vector<Element>& elements, Format format,
+                             std::uint64_t left) {
   std::uint64_t needed = 0;
   for (const Element& e : elements) {
     if (e.count > 0 && e.properties.empty()) {
@@ -402,7 +442,7 @@ std::string read_ply(std::string_view bytes, RawPolygons& out) {
     }
     std::uint64_t record = 0;
     for (const Property& p : e.properties) {
-      record += *format == Format::kAscii ? 2 : size_of(p.list ? p.count_type : p.type);
+      record += format == Format::kAscii ? 2 : size_of(p.list ? p.count_type : p.type);
     }
     if (e.count > kMaxIndexable || (record > 0 && e.count > (left - needed) / record)) {
       return "the header claims " + std::to_string(e.count) + " '" + e.name +
@@ -411,75 +451,116 @@ std::string read_ply(std::string_view bytes, RawPolygons& out) {
     }
     needed += e.count * record;
   }
+  return {};
+}
 
+// Which properties of an element the mesh needs: x, y, z of the first 'vertex' element, the
+// index list of a 'face' element; -1 where absent.
+struct PlyRoles {
+  bool is_vertex = false;
+  bool is_face = false;
+  int xyz[3] = {-1, -1, -1};
+  int indices = -1;
+};
+
+PlyRoles ply_roles(const Element& e, bool saw_vertices) {
+  PlyRoles r;
+  r.is_vertex = e.name == "vertex" && !saw_vertices;
+  r.is_face = e.name == "face";
+  for (std::size_t i = 0; i < e.properties.size(); ++i) {
+    const Property& p = e.properties[i];
+    if (r.is_vertex && !p.list) {
+      if (p.name == "x") r.xyz[0] = int(i);
+      if (p.name == "y") r.xyz[1] = int(i);
+      if (p.name == "z") r.xyz[2] = int(i);
+    }
+    if (r.is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+      r.indices = int(i);
+    }
+  }
+  return r;
+}
+
+// One list property of a record; its items are kept in out.corners when `keep`.
+std::string read_ply_list(Values& values, const Property& prop, Format format, bool keep,
+                          RawPolygons& out) {
+  double value = 0;
+  if (std::string problem = values.next(prop.count_type, value); !problem.empty()) {
+    return problem;
+  }
+  // Checked against what is left before the items are read, so a forged count costs
+  // neither memory nor time.
+  const std::uint64_t per_item = format == Format::kAscii ? 2 : size_of(prop.type);
+  if (value < 0 || value > double(values.remaining() / per_item + 1)) {
+    return "list '" + prop.name + "' claims " + std::to_string(value) +
+           " items, more than the rest of the file holds";
+  }
+  const auto n = std::uint64_t(value);
+  for (std::uint64_t k = 0; k < n; ++k) {
+    if (std::string problem = values.next(prop.type, value); !problem.empty()) return problem;
+    if (keep) {
+      if (!(std::abs(value) < 9.2e18) || value != std::floor(value)) {
+        return "vertex index " + std::to_string(value) + " is not an integer";
+      }
+      out.corners.push_back(std::int64_t(value));
+    }
+  }
+  return {};
+}
+
+std::string read_ply_element(Values& values, const Element& e, const PlyRoles& roles, Format format,
+                             RawPolygons& out) {
+  if (roles.is_vertex) out.positions.reserve(e.count);
+  if (roles.is_face) out.face_offsets.reserve(out.face_offsets.size() + e.count);
+  for (std::uint64_t r = 0; r < e.count; ++r) {
+    const auto where = [&] { return "'" + e.name + "' record " + std::to_string(r) + ": "; };
+    float p[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < e.properties.size(); ++i) {
+      const Property& prop = e.properties[i];
+      std::string problem;
+      if (prop.list) {
+        problem =
+            read_ply_list(values, prop, format, roles.is_face && roles.indices == int(i), out);
+      } else {
+        double value = 0;
+        problem = values.next(prop.type, value);
+        for (int k = 0; k < 3; ++k) {
+          if (roles.is_vertex && roles.xyz[k] == int(i)) p[k] = float(value);
+        }
+      }
+      if (!problem.empty()) return where() + problem;
+    }
+    if (roles.is_vertex) out.positions.emplace_back(p[0], p[1], p[2]);
+    if (roles.is_face && roles.indices >= 0) out.face_offsets.push_back(out.corners.size());
+  }
+  return {};
+}
+
+}  // namespace
+
+std::string read_ply(std::string_view bytes, RawPolygons& out) {
+  Lines lines(bytes);
+  std::optional<Format> format;
+  std::vector<Element> elements;
+  if (std::string problem = read_ply_header(lines, format, elements); !problem.empty()) {
+    return problem;
+  }
+  const std::uint64_t left = lines.remaining();
+  if (std::string problem = check_ply_counts(elements, *format, left); !problem.empty()) {
+    return problem;
+  }
   Values values(bytes.substr(bytes.size() - left), *format);
   bool saw_vertices = false;
   for (const Element& e : elements) {
-    const bool is_vertex = e.name == "vertex" && !saw_vertices;
-    const bool is_face = e.name == "face";
-    int xyz[3] = {-1, -1, -1};
-    int indices = -1;
-    for (std::size_t i = 0; i < e.properties.size(); ++i) {
-      const Property& p = e.properties[i];
-      if (is_vertex && !p.list) {
-        if (p.name == "x") xyz[0] = int(i);
-        if (p.name == "y") xyz[1] = int(i);
-        if (p.name == "z") xyz[2] = int(i);
-      }
-      if (is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
-        indices = int(i);
-      }
-    }
-    if (is_vertex) {
-      if (xyz[0] < 0 || xyz[1] < 0 || xyz[2] < 0) {
+    const PlyRoles roles = ply_roles(e, saw_vertices);
+    if (roles.is_vertex) {
+      if (roles.xyz[0] < 0 || roles.xyz[1] < 0 || roles.xyz[2] < 0) {
         return "element 'vertex' lacks one of the scalar properties x, y, z";
       }
       saw_vertices = true;
-      out.positions.reserve(e.count);
     }
-    if (is_face) out.face_offsets.reserve(out.face_offsets.size() + e.count);
-
-    for (std::uint64_t r = 0; r < e.count; ++r) {
-      const auto where = [&] { return "'" + e.name + "' record " + std::to_string(r) + ": "; };
-      float p[3] = {0, 0, 0};
-      for (std::size_t i = 0; i < e.properties.size(); ++i) {
-        const Property& prop = e.properties[i];
-        double value = 0;
-        if (!prop.list) {
-          if (std::string problem = values.next(prop.type, value); !problem.empty()) {
-            return where() + problem;
-          }
-          for (int k = 0; k < 3; ++k) {
-            if (is_vertex && xyz[k] == int(i)) p[k] = float(value);
-          }
-          continue;
-        }
-        if (std::string problem = values.next(prop.count_type, value); !problem.empty()) {
-          return where() + problem;
-        }
-        // Checked against what is left before the items are read, so a forged count costs
-        // neither memory nor time.
-        const std::uint64_t per_item = *format == Format::kAscii ? 2 : size_of(prop.type);
-        if (value < 0 || value > double(values.remaining() / per_item + 1)) {
-          return where() + "list '" + prop.name + "' claims " + std::to_string(value) +
-                 " items, more than the rest of the file holds";
-        }
-        const auto n = std::uint64_t(value);
-        const bool keep = is_face && indices == int(i);
-        for (std::uint64_t k = 0; k < n; ++k) {
-          if (std::string problem = values.next(prop.type, value); !problem.empty()) {
-            return where() + problem;
-          }
-          if (keep) {
-            if (!(std::abs(value) < 9.2e18) || value != std::floor(value)) {
-              return where() + "vertex index " + std::to_string(value) + " is not an integer";
-            }
-            out.corners.push_back(std::int64_t(value));
-          }
-        }
-      }
-      if (is_vertex) out.positions.emplace_back(p[0], p[1], p[2]);
-      if (is_face && indices >= 0) out.face_offsets.push_back(out.corners.size());
+    if (std::string problem = read_ply_element(values, e, roles, *format, out); !problem.empty()) {
+      return problem;
     }
   }
   if (!saw_vertices) return "the header declares no 'vertex' element";

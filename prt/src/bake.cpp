@@ -3,6 +3,7 @@
 #include "prt/bake.h"
 
 #include "bake_engine.h"
+#include "meshes/weld.h"
 
 #include "prt/ray_scene.h"
 #include "prt/sampling.h"
@@ -22,7 +23,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 namespace prt {
 namespace {
@@ -141,24 +141,10 @@ constexpr float kLift = 0.1f;
 constexpr float kEscape = 10.f;
 
 OriginFaces origin_faces(const meshes::Mesh& mesh, float offset) {
-  struct Key {
-    float x, y, z;
-    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-  };
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const {
-      return std::hash<float>()(k.x) ^ (std::hash<float>()(k.y) * 31) ^
-             (std::hash<float>()(k.z) * 131);
-    }
-  };
   OriginFaces f;
-  std::unordered_map<Key, std::uint32_t, KeyHash> group_of;
-  f.group.resize(mesh.vertex_count());
-  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-    const meshes::Vec3& p = mesh.positions[v];
-    f.group[v] =
-        group_of.emplace(Key{p.x(), p.y(), p.z()}, std::uint32_t(group_of.size())).first->second;
-  }
+  meshes::PositionGroups groups = meshes::group_equal_positions(mesh.positions);
+  f.group = std::move(groups.group);
+  const std::size_t group_count = groups.count();
   // Zero-area faces have no plane to start above; they are left out.
   auto unit_normal = [&](const meshes::Triangle& t) {
     return (mesh.positions[t[1]] - mesh.positions[t[0]])
@@ -166,12 +152,12 @@ OriginFaces origin_faces(const meshes::Mesh& mesh, float offset) {
         .normalized()
         .eval();
   };
-  f.first.assign(group_of.size() + 1, 0);
+  f.first.assign(group_count + 1, 0);
   for (const meshes::Triangle& t : mesh.triangles) {
     if (!unit_normal(t).allFinite()) continue;
     for (int c = 0; c < 3; ++c) ++f.first[f.group[t[c]] + 1];
   }
-  for (std::size_t g = 0; g < group_of.size(); ++g) f.first[g + 1] += f.first[g];
+  for (std::size_t g = 0; g < group_count; ++g) f.first[g + 1] += f.first[g];
   std::vector<std::uint32_t> fill(f.first.begin(), f.first.end() - 1);
   f.normals.resize(3, f.first.back());
   f.steps.resize(3, f.first.back());

@@ -1,5 +1,7 @@
-// meshes/load.h: reading meshes from disk: OBJ and STL through OpenMesh, OFF, PLY and 3DS
-// through our own strict readers.
+// meshes/load.h: reading meshes from disk: OBJ and STL through OpenMesh, OFF and PLY through
+// our own strict readers, glTF 2.0 (.gltf, .glb) and 3DS through Assimp behind our guards
+// (docs/ARCHITECTURE.md, "Mesh assets"). A glTF or 3DS scene is flattened into world space
+// through its node transforms.
 //
 // Loading triangulates polygons (fan), drops degenerate faces (repeated index or zero area
 // after welding), welds positions closer than `weld_tolerance` times the bounding-box
@@ -25,8 +27,10 @@ struct LoadOptions {
 // What loading found and changed; printed by `prtr mesh`.
 struct LoadReport {
   std::string path;
-  std::string format;  // lower-case extension: "obj", "ply", "off", "stl"
-  // As the reader delivered them. Ours (OFF, PLY, 3DS) deliver every record; OpenMesh's are
+  std::string format;  // lower-case extension: "obj", "ply", "off", "stl", "gltf", "glb", "3ds"
+  // As the reader delivered them. Ours (OFF, PLY) deliver every record; Assimp delivers
+  // glTF accessors as they are and 3DS corners unshared (three vertices per face), each
+  // mesh once per node that uses it, without point and line primitives; OpenMesh's are
   // not always complete: its OBJ reader skips faces that repeat a vertex index or have fewer
   // than three corners, and its STL reader merges bit-identical corners and skips triangles
   // that repeat one. Such faces are in neither file_faces nor degenerate_faces_dropped.
@@ -46,10 +50,13 @@ struct LoadReport {
 // unreadable file, a directory, an unknown extension, an empty file, content the reader
 // cannot parse (including header counts the file is too small to hold, and OBJ face corners
 // without a vertex number), a face naming a vertex that does not exist, NaN/Inf coordinates,
-// a file too large for memory, or no faces (in the file, or left after clean-up). Memory use
-// is bounded by a constant times the file size, whatever the file claims. The binary/ASCII decision
-// for .stl is made by file size (84 + 50 n bytes is binary), not by OpenMesh's "starts with solid"
-// test.
+// a file too large for memory, or no faces (in the file, or left after clean-up); for glTF
+// and 3DS also for what asset_guard.h refuses (claims past the data, URIs outside the file's
+// folder, deep nesting) and for skins, morph targets and point/line-only scenes. Memory use
+// is bounded by a constant times the file size, whatever the file claims (for glTF, whose
+// nodes may reuse a mesh, also by a limit of 2^26 vertices on the flattened scene). The
+// binary/ASCII decision for .stl is made by file size (84 + 50 n bytes is binary), not by
+// OpenMesh's "starts with solid" test.
 Mesh load_mesh(const std::filesystem::path& path, const LoadOptions& options = {},
                LoadReport* report = nullptr);
 
