@@ -2,9 +2,9 @@
 // integration, the cross and face-set readers, and the SH projection with exact texel solid
 // angles against analytic values and against the lat-long projection.
 #include "probes/cube_map.h"
-#include "cube_projection.h"
 #include "probes/load.h"
 #include "probes/procedural.h"
+#include "prt/cube_projection.h"
 #include "prt/projection.h"
 #include "prt/sh.h"
 
@@ -100,7 +100,7 @@ TEST(CubeProjection, ConstantGivesTheConstantsSh) {
   // cube's rotations and the antipodal map, which leave no invariant in bands 1 to 3 (band 4
   // has one, so it is not tested to rounding).
   const Rgb c(0.5f, 1.0f, 2.0f);
-  const prt::ShLighting sh = prtr_app::project_cube(constant_cube(16, c), 4);
+  const prt::ShLighting sh = prt::project_cube(constant_cube(16, c), 4);
   for (int ch = 0; ch < 3; ++ch) {
     EXPECT_NEAR(sh(0, ch), c[ch] * std::sqrt(4 * kPi), 1e-12);
     for (int i = 1; i < sh.rows(); ++i) EXPECT_NEAR(sh(i, ch), 0.0, 1e-12) << i;
@@ -110,7 +110,7 @@ TEST(CubeProjection, ConstantGivesTheConstantsSh) {
 TEST(CubeProjection, BrightTexelProjectsAsAPointLightInItsDirection) {
   // A single texel of radiance L and solid angle w projects to L w Y_lm(d) exactly.
   const CubeMap cube = one_bright_texel(8, 3, 2, 5);
-  const prt::ShLighting sh = prtr_app::project_cube(cube, 3);
+  const prt::ShLighting sh = prt::project_cube(cube, 3);
   Eigen::VectorXd basis(9);
   prt::sh_eval(3, cube.texel_direction(3, 2, 5), basis.data());
   const double w = cube.texel_solid_angle(2, 5);
@@ -172,7 +172,7 @@ TEST(CubeCross, LatLongResampledToACrossHasTheSameSh) {
     probes::LoadReport report;
     const probes::Probe back = probes::load_probe(dir / "cross.exr", {}, &report);
     ASSERT_TRUE(report.cube);
-    const prt::ShLighting exact = prtr_app::project_cube(*report.cube, 3);
+    const prt::ShLighting exact = prt::project_cube(*report.cube, 3);
     const prt::ShLighting reference = prt::project(latlong, 3);
     EXPECT_LT((exact - reference).cwiseAbs().maxCoeff(), 5e-4) << exact - reference;
     // The lat-long map the renderer gets back projects the same way.

@@ -1,8 +1,9 @@
-// Loop subdivision (apps/prtr/loop_subdivision.h): exact counts on a closed mesh, the convex
+// Loop subdivision (meshes/subdivide.h): exact counts on a closed mesh, the convex
 // hull bound on a sphere, and the PLY it writes read back by the mesh loader.
-#include "loop_subdivision.h"
+#include "meshes/subdivide.h"
 #include "meshes/load.h"
 #include "meshes/mesh.h"
+#include "meshes/write_ply.h"
 
 #include <gtest/gtest.h>
 
@@ -66,7 +67,7 @@ TEST(LoopSubdivision, ClosedMeshCountsFollowTheExactFormulas) {
     // One round: a new vertex per edge (V' = V + E), four triangles per triangle (F' = 4F).
     const std::size_t v = expected.vertex_count() + edge_count(expected);
     const std::size_t f = 4 * expected.triangle_count();
-    const meshes::Mesh refined = prtr_app::loop_subdivide(base, steps);
+    const meshes::Mesh refined = meshes::loop_subdivide(base, steps);
     EXPECT_EQ(refined.vertex_count(), v) << steps << " step(s)";
     EXPECT_EQ(refined.triangle_count(), f) << steps << " step(s)";
     // Still closed: Euler characteristic 2 and every edge in exactly two triangles (E = 3F/2).
@@ -90,7 +91,7 @@ TEST(LoopSubdivision, SphereVerticesStayBetweenTheHullBoundAndTheSphere) {
       max_angle = std::max(max_angle, std::acos(std::clamp(dot, -1.f, 1.f)));
     }
   }
-  const meshes::Mesh refined = prtr_app::loop_subdivide(sphere, 1);
+  const meshes::Mesh refined = meshes::loop_subdivide(sphere, 1);
   ASSERT_EQ(refined.vertex_count(), sphere.vertex_count() + edge_count(sphere));
   float lo = 2.f, hi = 0.f;
   for (const meshes::Vec3& p : refined.positions) {
@@ -105,11 +106,11 @@ TEST(LoopSubdivision, SphereVerticesStayBetweenTheHullBoundAndTheSphere) {
 }
 
 TEST(LoopSubdivision, WrittenPlyLoadsBackUnchanged) {
-  const meshes::Mesh refined = prtr_app::loop_subdivide(icosahedron(), 1);
+  const meshes::Mesh refined = meshes::loop_subdivide(icosahedron(), 1);
   const std::filesystem::path dir = PRTR_TEST_TMPDIR;
   std::filesystem::create_directories(dir);
   const std::filesystem::path path = dir / "loop_icosahedron.ply";
-  prtr_app::write_ply(path, refined);
+  meshes::write_ply(path, refined);
   meshes::LoadOptions no_weld;
   no_weld.weld_tolerance = -1.0;
   const meshes::Mesh back = meshes::load_mesh(path, no_weld);
@@ -124,7 +125,7 @@ TEST(LoopSubdivision, WrittenPlyLoadsBackUnchanged) {
 TEST(LoopSubdivision, NonManifoldInputIsRefusedByName) {
   meshes::Mesh m = icosahedron();
   m.triangles.push_back(m.triangles[0]);  // a third face on the same edges
-  EXPECT_THROW(prtr_app::loop_subdivide(m, 1), meshes::MeshError);
+  EXPECT_THROW(meshes::loop_subdivide(m, 1), meshes::MeshError);
 }
 
 }  // namespace

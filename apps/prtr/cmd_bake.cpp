@@ -64,7 +64,7 @@ Runner add_bake_command(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "bake", "Bake per-vertex SH transfer (shadow and interreflection passes) to a .prtx file");
-  cmd->add_option("MESH", opt->mesh, "Mesh file (OBJ, PLY, OFF, STL)")->required();
+  cmd->add_option("MESH", opt->mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("-o,--output", opt->output, "Transfer file to write (.prtx)")->required();
   add_bake_flags(cmd, opt->flags);
   cmd->add_option("--block-vertices", opt->block,

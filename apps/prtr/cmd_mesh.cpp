@@ -1,7 +1,8 @@
 // prtr mesh FILE: load a mesh the way every later stage will, and print what was found;
 // with -o, write it (after --subdivide N rounds of Loop subdivision) as binary PLY.
 #include "commands.h"
-#include "loop_subdivision.h"
+#include "meshes/subdivide.h"
+#include "meshes/write_ply.h"
 
 #include "meshes/load.h"
 
@@ -22,7 +23,7 @@ Runner add_mesh_command(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* cmd =
       app.add_subcommand("mesh", "Load a mesh (OBJ, PLY, OFF, STL) and print its facts");
-  cmd->add_option("MESH", opt->path, "Mesh file")->required();
+  cmd->add_option("MESH", opt->path, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("--weld-tolerance", opt->weld,
                   "Weld positions closer than this fraction of the bounding-box diagonal "
                   "(negative: no welding)")
@@ -69,8 +70,8 @@ Runner add_mesh_command(CLI::App& app) {
     std::printf("hash        %016llx\n",
                 static_cast<unsigned long long>(meshes::content_hash(mesh)));
     if (opt->output.empty()) return;
-    const meshes::Mesh refined = loop_subdivide(mesh, opt->subdivide);
-    write_ply(opt->output, refined);
+    const meshes::Mesh refined = meshes::loop_subdivide(mesh, opt->subdivide);
+    meshes::write_ply(opt->output, refined);
     std::printf("wrote       %s: %d round(s) of Loop subdivision, %zu vertices, %zu triangles\n",
                 opt->output.c_str(), opt->subdivide, refined.vertex_count(),
                 refined.triangle_count());

@@ -14,6 +14,7 @@
 
 #include "common/atomic_file.h"
 #include "cpca/supercluster_strategy.h"
+#include "meshes/load.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -70,7 +71,7 @@ std::vector<int> parse_clusters(const std::string& text) {
 }
 
 void add_flags(CLI::App* cmd, Options& o) {
-  cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, OFF, STL, 3DS)")->required();
+  cmd->add_option("MESH", o.mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("--probe", o.probe, "Environment map lighting every render")->required();
   cmd->add_option("--transfer", o.transfer,
                   "Bake of MESH (.prtx); without it the mesh is baked with the bake flags and "

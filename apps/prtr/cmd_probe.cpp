@@ -1,6 +1,6 @@
 // prtr probe FILE: load an environment map, print its facts and its SH projection.
 #include "commands.h"
-#include "cube_projection.h"
+#include "prt/cube_projection.h"
 
 #include "probes/load.h"
 #include "prt/projection.h"
@@ -66,7 +66,7 @@ Runner add_probe_command(CLI::App& app) {
     // commands light with its lat-long resampling, whose projection is shown beside it.
     const auto start = std::chrono::steady_clock::now();
     const prt::ShLighting sh =
-        report.cube ? project_cube(*report.cube, opt->order) : prt::project(probe, opt->order);
+        report.cube ? prt::project_cube(*report.cube, opt->order) : prt::project(probe, opt->order);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 

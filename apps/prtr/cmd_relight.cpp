@@ -75,7 +75,7 @@ struct Options {
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
-  cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, OFF, STL, 3DS)")->required();
+  cmd->add_option("MESH", o.mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
   cmd->add_option("--frames", o.frames, "Frames in the sequence")

@@ -37,7 +37,7 @@ struct Options {
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
-  cmd->add_option("MESH", o.mesh, "Mesh file (OBJ, PLY, OFF, STL, 3DS)")->required();
+  cmd->add_option("MESH", o.mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("--probe", o.probe,
                   "Light probe (EXR/HDR); the page offers every *.exr/*.hdr in its folder")
       ->required();

@@ -17,6 +17,9 @@
 
 namespace meshes {
 
+// The formats load_mesh reads, as command help names them.
+inline constexpr const char* kMeshFormats = "OBJ, PLY, OFF, STL, glTF 2.0 (.gltf, .glb), 3DS";
+
 struct LoadOptions {
   // Relative to the bounding-box diagonal; 0 welds only bit-identical positions, a negative
   // value disables welding.

@@ -1,14 +1,14 @@
-#include "cube_projection.h"
+#include "prt/cube_projection.h"
 
 #include "prt/sh.h"
 
 #include <vector>
 
-namespace prtr_app {
+namespace prt {
 
-prt::ShLighting project_cube(const probes::CubeMap& cube, int order) {
-  prt::check_order(order, "projection order");
-  const int n = prt::sh_count(order), size = cube.size();
+ShLighting project_cube(const probes::CubeMap& cube, int order) {
+  check_order(order, "projection order");
+  const int n = sh_count(order), size = cube.size();
   // Solid angles are the same on every face.
   std::vector<double> solid_angle(std::size_t(size) * std::size_t(size));
   for (int y = 0; y < size; ++y) {
@@ -17,9 +17,9 @@ prt::ShLighting project_cube(const probes::CubeMap& cube, int order) {
           cube.texel_solid_angle(x, y);
     }
   }
-  prt::ShLighting total = prt::ShLighting::Zero(n, 3);
+  ShLighting total = ShLighting::Zero(n, 3);
   Eigen::Matrix3Xd directions(3, size);
-  prt::ShBatchD basis(n, size);
+  ShBatchD basis(n, size);
   Eigen::Matrix<double, Eigen::Dynamic, 3> weighted(size, 3);
   for (int face = 0; face < probes::kCubeFaces; ++face) {
     for (int y = 0; y < size; ++y) {
@@ -28,11 +28,11 @@ prt::ShLighting project_cube(const probes::CubeMap& cube, int order) {
         weighted.row(x) = cube.texel(face, x, y).cast<double>().transpose() *
                           solid_angle[std::size_t(y) * std::size_t(size) + std::size_t(x)];
       }
-      prt::sh_eval_batch(order, directions, basis);
+      sh_eval_batch(order, directions, basis);
       total.noalias() += basis * weighted;
     }
   }
   return total;
 }
 
-}  // namespace prtr_app
+}  // namespace prt
