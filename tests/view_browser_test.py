@@ -38,16 +38,7 @@ PIXELS = """(() => {
   return {w: c.width, h: c.height, mean: m, std: Math.sqrt(Math.max(0, s2 / n - m * m)), hash: h};
 })()"""
 
-passed = failed = 0
-
-
-def check(name, ok, detail=""):
-    global passed, failed
-    if ok:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL: %s %s" % (name, detail))
+check = vs.Checks()
 
 
 def text(browser, element):
@@ -171,8 +162,8 @@ def main():
         code = server.stop() if server else None
     check("server exits 0 on SIGTERM", code == 0, str(code))
     print("view_browser_test: %d passed, %d failed in %.1f s" %
-          (passed, failed, time.monotonic() - started))
-    return 1 if failed else 0
+          (check.passed, check.failed, time.monotonic() - started))
+    return 1 if check.failed else 0
 
 
 if __name__ == "__main__":

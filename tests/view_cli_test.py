@@ -18,16 +18,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import view_support as vs  # noqa: E402
 
-passed = failed = 0
-
-
-def check(name, ok, detail=""):
-    global passed, failed
-    if ok:
-        passed += 1
-    else:
-        failed += 1
-        print("FAIL: %s %s" % (name, detail))
+check = vs.Checks()
 
 
 def oiio_stats(path):
@@ -162,8 +153,8 @@ def main():
     check_usage(prtr, mesh, probe, cache)
     leftovers = [f for f in os.listdir(cache) if "tmp" in f]
     check("no temporary files in the cache", not leftovers, str(leftovers))
-    print("view_cli_test: %d passed, %d failed" % (passed, failed))
-    return 1 if failed else 0
+    print("view_cli_test: %d passed, %d failed" % (check.passed, check.failed))
+    return 1 if check.failed else 0
 
 
 if __name__ == "__main__":

@@ -171,3 +171,18 @@ def jpeg_size(data):
 
 def frame_info(headers):
     return json.loads(headers["x-prtr-frame"])
+
+
+class Checks:
+    """Counts named checks; a failure prints its name and detail and the run goes on."""
+
+    def __init__(self):
+        self.passed = 0
+        self.failed = 0
+
+    def __call__(self, name, ok, detail=""):
+        if ok:
+            self.passed += 1
+        else:
+            self.failed += 1
+            print("FAIL: %s %s" % (name, detail))
