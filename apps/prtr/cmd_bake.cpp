@@ -2,6 +2,7 @@
 // to the file block by block (prt::bake_to_file), so the payload never sits in memory whole.
 #include "bake_flags.h"
 #include "commands.h"
+#include "json_output.h"
 #include "meshes/load.h"
 #include "pipeline.h"
 #include "progress_bar.h"
@@ -16,7 +17,6 @@
 namespace prtr_app {
 namespace {
 
-// The bake with a progress bar; memory is bounded by the block, so no estimate is checked.
 // "k/n" as {k, n}; {0, 0} for no shard.
 std::pair<std::uint32_t, std::uint32_t> parse_shard(const std::string& text) {
   if (text.empty()) return {0, 0};
@@ -29,6 +29,7 @@ std::pair<std::uint32_t, std::uint32_t> parse_shard(const std::string& text) {
   return {std::uint32_t(k), std::uint32_t(n)};
 }
 
+// The bake with a progress bar; memory is bounded by the block, so no estimate is checked.
 prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
                              const std::string& output, std::uint64_t block,
                              std::pair<std::uint32_t, std::uint32_t> shard, bool quiet,
@@ -49,6 +50,63 @@ prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
           : prt::bake_to_file(mesh, options, output, block, stats);
   bar.finish();
   return set;
+}
+
+// Vertices that see (almost) none of their sky are named, because on a sound closed or open
+// surface they are rare: they render black and usually point at broken geometry. Moved
+// origins are named too: their vertex lies just inside the surface (a fold), which the bake
+// worked around but the mesh still has. Both lists are cut at eight ids.
+constexpr std::size_t kIdsShown = 8;
+
+std::string id_list(const std::vector<std::uint32_t>& v) {
+  std::string text;
+  for (std::size_t i = 0; i < std::min(v.size(), kIdsShown); ++i) {
+    text += (i ? ", " : " (") + std::to_string(v[i]);
+  }
+  if (!v.empty()) text += v.size() > kIdsShown ? ", ...)" : ")";
+  return text;
+}
+
+Json summary_json(const meshes::Mesh& mesh, const prt::BakeStats& stats) {
+  const auto first = [](const std::vector<std::uint32_t>& v) {
+    return std::vector<std::uint32_t>(v.begin(), v.begin() + std::min(v.size(), kIdsShown));
+  };
+  Json j;
+  j["vertices"] = mesh.vertex_count();
+  j["seconds_total"] = stats.seconds_total;
+  j["seconds_shadow"] = stats.seconds_shadow;
+  j["seconds_bounces"] = stats.seconds_bounces;
+  j["seconds_brdf"] = stats.seconds_brdf;
+  j["rays_shadow"] = stats.rays_shadow;
+  j["rays_bounce"] = stats.rays_bounce;
+  j["occluded_fraction"] = stats.occluded_fraction;
+  j["nearly_occluded_vertices"] = stats.occluded_vertices.size();
+  j["nearly_occluded_ids"] = first(stats.occluded_vertices);
+  j["moved_origin_vertices"] = stats.moved_origins.size();
+  j["moved_origin_ids"] = first(stats.moved_origins);
+  return j;
+}
+
+void print_summary(const std::string& mesh_path, const std::string& output,
+                   const meshes::Mesh& mesh, const prt::TransferSet& set,
+                   const prt::BakeStats& stats) {
+  const std::vector<std::uint32_t>& dark = stats.occluded_vertices;
+  const std::vector<std::uint32_t>& moved = stats.moved_origins;
+  const double rays = double(stats.rays_shadow + stats.rays_bounce);
+  std::printf("baked       %s -> %s\n", mesh_path.c_str(), output.c_str());
+  std::printf("transfer    %s, order %d, %d channel(s), %zu vertices, %s\n",
+              prt::transfer_kind_name(set.kind), set.order, set.channels, mesh.vertex_count(),
+              format_bytes(set.vertex_count * set.floats_per_vertex() * sizeof(float)).c_str());
+  std::printf("time        %.2f s total: %.2f s shadow, %.2f s bounces, %.2f s BRDF matrix\n",
+              stats.seconds_total, stats.seconds_shadow, stats.seconds_bounces, stats.seconds_brdf);
+  std::printf("rays        %.1f M (%.1f M shadow, %.1f M bounce), %.1f M rays/s\n", rays / 1e6,
+              double(stats.rays_shadow) / 1e6, double(stats.rays_bounce) / 1e6,
+              rays / 1e6 / (stats.seconds_shadow + stats.seconds_bounces));
+  std::printf(
+      "occluded    %.1f%% of shadow rays; %zu %s with < %g%% of rays escaping%s; %zu moved "
+      "out from just inside the surface%s\n",
+      100.0 * stats.occluded_fraction, dark.size(), dark.size() == 1 ? "vertex" : "vertices",
+      100.0 * prt::kNearlyOccluded, id_list(dark).c_str(), moved.size(), id_list(moved).c_str());
 }
 
 }  // namespace
@@ -84,52 +142,11 @@ Runner add_bake_command(CLI::App& app) {
     const prt::TransferSet set = stream_bake(mesh, options, o.output, o.block, parse_shard(o.shard),
                                              o.quiet || o.json, &stats);
 
-    // A sound closed or open surface rarely has a vertex that sees (almost) none of its sky,
-    // so these are named: they render black and usually point at broken geometry.
-    // Moved origins are named too: their vertex lies just inside the surface (a fold), which
-    // the bake worked around but the mesh still has.
-    auto ids = [](const std::vector<std::uint32_t>& v, std::string* json, std::string* text) {
-      for (std::size_t i = 0; i < std::min<std::size_t>(v.size(), 8); ++i) {
-        *json += (i ? "," : "") + std::to_string(v[i]);
-        *text += (i ? ", " : " (") + std::to_string(v[i]);
-      }
-      if (!v.empty()) *text += v.size() > 8 ? ", ...)" : ")";
-    };
-    const std::vector<std::uint32_t>& dark = stats.occluded_vertices;
-    const std::vector<std::uint32_t>& moved = stats.moved_origins;
-    std::string dark_ids, dark_list, moved_ids, moved_list;
-    ids(dark, &dark_ids, &dark_list);
-    ids(moved, &moved_ids, &moved_list);
     if (o.json) {
-      std::printf(
-          "{\"vertices\":%zu,\"seconds_total\":%.4f,\"seconds_shadow\":%.4f,"
-          "\"seconds_bounces\":%.4f,\"seconds_brdf\":%.4f,\"rays_shadow\":%llu,"
-          "\"rays_bounce\":%llu,\"occluded_fraction\":%.6f,\"nearly_occluded_vertices\":%zu,"
-          "\"nearly_occluded_ids\":[%s],\"moved_origin_vertices\":%zu,"
-          "\"moved_origin_ids\":[%s]}\n",
-          mesh.vertex_count(), stats.seconds_total, stats.seconds_shadow, stats.seconds_bounces,
-          stats.seconds_brdf, (unsigned long long)stats.rays_shadow,
-          (unsigned long long)stats.rays_bounce, stats.occluded_fraction, dark.size(),
-          dark_ids.c_str(), moved.size(), moved_ids.c_str());
-      return;
+      std::printf("%s\n", dump_json(summary_json(mesh, stats)).c_str());
+    } else {
+      print_summary(o.mesh, o.output, mesh, set, stats);
     }
-
-    const double rays = double(stats.rays_shadow + stats.rays_bounce);
-    std::printf("baked       %s -> %s\n", o.mesh.c_str(), o.output.c_str());
-    std::printf("transfer    %s, order %d, %d channel(s), %zu vertices, %s\n",
-                prt::transfer_kind_name(set.kind), set.order, set.channels, mesh.vertex_count(),
-                format_bytes(set.vertex_count * set.floats_per_vertex() * sizeof(float)).c_str());
-    std::printf("time        %.2f s total: %.2f s shadow, %.2f s bounces, %.2f s BRDF matrix\n",
-                stats.seconds_total, stats.seconds_shadow, stats.seconds_bounces,
-                stats.seconds_brdf);
-    std::printf("rays        %.1f M (%.1f M shadow, %.1f M bounce), %.1f M rays/s\n", rays / 1e6,
-                double(stats.rays_shadow) / 1e6, double(stats.rays_bounce) / 1e6,
-                rays / 1e6 / (stats.seconds_shadow + stats.seconds_bounces));
-    std::printf(
-        "occluded    %.1f%% of shadow rays; %zu %s with < %g%% of rays escaping%s; %zu moved "
-        "out from just inside the surface%s\n",
-        100.0 * stats.occluded_fraction, dark.size(), dark.size() == 1 ? "vertex" : "vertices",
-        100.0 * prt::kNearlyOccluded, dark_list.c_str(), moved.size(), moved_list.c_str());
   };
 }
 

@@ -1,16 +1,43 @@
 // prtr mesh FILE: load a mesh the way every later stage will, and print what was found;
 // with -o, write it (after --subdivide N rounds of Loop subdivision) as binary PLY.
 #include "commands.h"
-#include "meshes/subdivide.h"
-#include "meshes/write_ply.h"
 
 #include "meshes/load.h"
+#include "meshes/subdivide.h"
+#include "meshes/write_ply.h"
 
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
 namespace prtr_app {
+
+namespace {
+
+// What the file held, what loading cleaned up, and the result every later stage sees.
+void print_report(const meshes::LoadReport& report, const meshes::Mesh& mesh) {
+  const meshes::Bounds b = meshes::bounds(mesh);
+  double area = 0.0;
+  for (const meshes::Triangle& t : mesh.triangles) area += 0.5 * meshes::double_area(mesh, t);
+
+  std::printf("mesh        %s (%s)\n", report.path.c_str(), report.format.c_str());
+  std::printf("file        %zu vertices, %zu faces (%zu polygons triangulated)\n",
+              report.file_vertices, report.file_faces, report.polygons_triangulated);
+  std::printf(
+      "clean-up    %zu vertices welded, %zu unreferenced dropped, %zu degenerate "
+      "faces dropped\n",
+      report.vertices_welded, report.unreferenced_vertices_dropped,
+      report.degenerate_faces_dropped);
+  std::printf("result      %zu vertices, %zu triangles\n", mesh.vertex_count(),
+              mesh.triangle_count());
+  std::printf("bounds      min (%.6g, %.6g, %.6g)  max (%.6g, %.6g, %.6g)\n", b.min.x(), b.min.y(),
+              b.min.z(), b.max.x(), b.max.y(), b.max.z());
+  std::printf("diagonal    %.6g\n", b.diagonal());
+  std::printf("area        %.6g\n", area);
+  std::printf("hash        %016llx\n", static_cast<unsigned long long>(meshes::content_hash(mesh)));
+}
+
+}  // namespace
 
 Runner add_mesh_command(CLI::App& app) {
   struct Options {
@@ -21,8 +48,8 @@ Runner add_mesh_command(CLI::App& app) {
     std::string output;
   };
   auto opt = std::make_shared<Options>();
-  CLI::App* cmd =
-      app.add_subcommand("mesh", "Load a mesh (OBJ, PLY, OFF, STL) and print its facts");
+  CLI::App* cmd = app.add_subcommand(
+      "mesh", "Load a mesh and print its facts; optionally subdivide and write it");
   cmd->add_option("MESH", opt->path, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("--weld-tolerance", opt->weld,
                   "Weld positions closer than this fraction of the bounding-box diagonal "
@@ -49,26 +76,7 @@ Runner add_mesh_command(CLI::App& app) {
         opt->normals == "area" ? meshes::NormalWeighting::kArea : meshes::NormalWeighting::kAngle;
     meshes::LoadReport report;
     const meshes::Mesh mesh = meshes::load_mesh(opt->path, options, &report);
-    const meshes::Bounds b = meshes::bounds(mesh);
-    double area = 0.0;
-    for (const meshes::Triangle& t : mesh.triangles) area += 0.5 * meshes::double_area(mesh, t);
-
-    std::printf("mesh        %s (%s)\n", report.path.c_str(), report.format.c_str());
-    std::printf("file        %zu vertices, %zu faces (%zu polygons triangulated)\n",
-                report.file_vertices, report.file_faces, report.polygons_triangulated);
-    std::printf(
-        "clean-up    %zu vertices welded, %zu unreferenced dropped, %zu degenerate "
-        "faces dropped\n",
-        report.vertices_welded, report.unreferenced_vertices_dropped,
-        report.degenerate_faces_dropped);
-    std::printf("result      %zu vertices, %zu triangles\n", mesh.vertex_count(),
-                mesh.triangle_count());
-    std::printf("bounds      min (%.6g, %.6g, %.6g)  max (%.6g, %.6g, %.6g)\n", b.min.x(),
-                b.min.y(), b.min.z(), b.max.x(), b.max.y(), b.max.z());
-    std::printf("diagonal    %.6g\n", b.diagonal());
-    std::printf("area        %.6g\n", area);
-    std::printf("hash        %016llx\n",
-                static_cast<unsigned long long>(meshes::content_hash(mesh)));
+    print_report(report, mesh);
     if (opt->output.empty()) return;
     const meshes::Mesh refined = meshes::loop_subdivide(mesh, opt->subdivide);
     meshes::write_ply(opt->output, refined);

@@ -25,6 +25,31 @@ void print_coefficients(const prt::ShLighting& sh, int order) {
   }
 }
 
+// What was read, what loading made of it, and the projection (a cube map's against its
+// lat-long resampling, which the other commands light with).
+void print_report(const probes::LoadReport& report, const probes::Probe& probe,
+                  const prt::ShLighting& sh, int order, double ms) {
+  const probes::Rgb peak = probe.max_texel();
+  const probes::Rgb mean = probe.mean_radiance();
+  std::printf("probe       %s (%s)\n", report.path.c_str(), report.format.c_str());
+  std::printf("file        %d x %d, %d channels, %s layout%s\n", report.file_width,
+              report.file_height, report.file_channels, probes::layout_name(report.layout),
+              report.layout != probes::Layout::kCross        ? ""
+              : report.cross == probes::CrossKind::kVertical ? " (vertical)"
+                                                             : " (horizontal)");
+  std::printf("lat-long    %d x %d\n", probe.width(), probe.height());
+  std::printf("clamped     %zu negative texels\n", report.negative_texels_clamped);
+  std::printf("peak        (%.6g, %.6g, %.6g)\n", peak.x(), peak.y(), peak.z());
+  std::printf("mean        (%.6g, %.6g, %.6g)  (solid-angle weighted radiance)\n", mean.x(),
+              mean.y(), mean.z());
+  std::printf("projection  order %d, %d coefficients, %.1f ms%s\n", order, prt::sh_count(order), ms,
+              report.cube ? ", cube texels with exact solid angles" : "");
+  if (report.cube) {
+    const double gap = (prt::project(probe, order) - sh).cwiseAbs().maxCoeff();
+    std::printf("resampled   lat-long projection differs by at most %.3g\n", gap);
+  }
+}
+
 }  // namespace
 
 Runner add_probe_command(CLI::App& app) {
@@ -70,26 +95,7 @@ Runner add_probe_command(CLI::App& app) {
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 
-    const probes::Rgb peak = probe.max_texel();
-    const probes::Rgb mean = probe.mean_radiance();
-    std::printf("probe       %s (%s)\n", report.path.c_str(), report.format.c_str());
-    std::printf("file        %d x %d, %d channels, %s layout%s\n", report.file_width,
-                report.file_height, report.file_channels, probes::layout_name(report.layout),
-                report.layout != probes::Layout::kCross        ? ""
-                : report.cross == probes::CrossKind::kVertical ? " (vertical)"
-                                                               : " (horizontal)");
-    std::printf("lat-long    %d x %d\n", probe.width(), probe.height());
-    std::printf("clamped     %zu negative texels\n", report.negative_texels_clamped);
-    std::printf("peak        (%.6g, %.6g, %.6g)\n", peak.x(), peak.y(), peak.z());
-    std::printf("mean        (%.6g, %.6g, %.6g)  (solid-angle weighted radiance)\n", mean.x(),
-                mean.y(), mean.z());
-    std::printf("projection  order %d, %d coefficients, %.1f ms%s\n", opt->order,
-                prt::sh_count(opt->order), ms,
-                report.cube ? ", cube texels with exact solid angles" : "");
-    if (report.cube) {
-      const double gap = (prt::project(probe, opt->order) - sh).cwiseAbs().maxCoeff();
-      std::printf("resampled   lat-long projection differs by at most %.3g\n", gap);
-    }
+    print_report(report, probe, sh, opt->order, ms);
     print_coefficients(sh, opt->order);
   };
 }

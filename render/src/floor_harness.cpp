@@ -17,22 +17,31 @@
 
 namespace render {
 
-double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const FloorOptions& options) {
-  camera.validate();
+namespace {
+
+// The draw's index buffer, and its positions: in cache order with first-use vertex numbering
+// when asked, as every render path's draws have (gpu_mesh.h).
+std::vector<std::uint32_t> floor_indices(const meshes::Mesh& mesh, const FloorOptions& options,
+                                         std::vector<meshes::Vec3>* positions) {
   std::vector<std::uint32_t> indices;
   indices.reserve(mesh.triangle_count() * 3);
   for (const auto& t : mesh.triangles) indices.insert(indices.end(), t.begin(), t.end());
-  if (options.optimize_vertex_cache) {
-    std::vector<std::uint32_t> optimised(indices.size());
-    meshopt_optimizeVertexCache(optimised.data(), indices.data(), indices.size(),
-                                mesh.vertex_count());
-    indices.swap(optimised);
-  }
-  // First-use vertex numbering, as every render path's draws have (gpu_mesh.h).
-  auto positions = mesh.positions;
-  if (options.optimize_vertex_cache)
-    meshopt_optimizeVertexFetch(positions.data(), indices.data(), indices.size(),
-                                mesh.positions.data(), mesh.vertex_count(), sizeof(positions[0]));
+  *positions = mesh.positions;
+  if (!options.optimize_vertex_cache) return indices;
+  std::vector<std::uint32_t> optimised(indices.size());
+  meshopt_optimizeVertexCache(optimised.data(), indices.data(), indices.size(),
+                              mesh.vertex_count());
+  meshopt_optimizeVertexFetch(positions->data(), optimised.data(), optimised.size(),
+                              mesh.positions.data(), mesh.vertex_count(), sizeof(meshes::Vec3));
+  return optimised;
+}
+
+}  // namespace
+
+double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const FloorOptions& options) {
+  camera.validate();
+  std::vector<meshes::Vec3> positions;
+  const std::vector<std::uint32_t> indices = floor_indices(mesh, options, &positions);
   GLuint vao = 0, vbo = 0, ibo = 0;
   glGenVertexArrays(1, &vao);
   glBindVertexArray(vao);
