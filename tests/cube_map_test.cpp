@@ -175,8 +175,11 @@ TEST(CubeCross, LatLongResampledToACrossHasTheSameSh) {
     const prt::ShLighting exact = prt::project_cube(*report.cube, 3);
     const prt::ShLighting reference = prt::project(latlong, 3);
     EXPECT_LT((exact - reference).cwiseAbs().maxCoeff(), 5e-4) << exact - reference;
-    // The lat-long map the renderer gets back projects the same way.
-    EXPECT_LT((prt::project(back, 3) - reference).cwiseAbs().maxCoeff(), 5e-4);
+    // The lat-long map the renderer gets back projects the same way, and every command
+    // (prt::project) integrates the cube the probe came from.
+    EXPECT_LT((prt::project_latlong(back, 3) - reference).cwiseAbs().maxCoeff(), 5e-4);
+    ASSERT_EQ(back.source_cube(), report.cube.get());
+    EXPECT_EQ(prt::project(back, 3), exact);
   }
 }
 

@@ -1,6 +1,5 @@
 // prtr probe FILE: load an environment map, print its facts and its SH projection.
 #include "commands.h"
-#include "prt/cube_projection.h"
 
 #include "probes/load.h"
 #include "prt/projection.h"
@@ -45,7 +44,7 @@ void print_report(const probes::LoadReport& report, const probes::Probe& probe,
   std::printf("projection  order %d, %d coefficients, %.1f ms%s\n", order, prt::sh_count(order), ms,
               report.cube ? ", cube texels with exact solid angles" : "");
   if (report.cube) {
-    const double gap = (prt::project(probe, order) - sh).cwiseAbs().maxCoeff();
+    const double gap = (prt::project_latlong(probe, order) - sh).cwiseAbs().maxCoeff();
     std::printf("resampled   lat-long projection differs by at most %.3g\n", gap);
   }
 }
@@ -87,11 +86,10 @@ Runner add_probe_command(CLI::App& app) {
     probes::LoadReport report;
     const probes::Probe probe = probes::load_probe(opt->path, options, &report);
 
-    // A cube map is projected over its own texels with their exact solid angles; the other
-    // commands light with its lat-long resampling, whose projection is shown beside it.
+    // A cube map is projected over its own texels with their exact solid angles (as in every
+    // command); the projection of its lat-long resampling is shown beside it.
     const auto start = std::chrono::steady_clock::now();
-    const prt::ShLighting sh =
-        report.cube ? prt::project_cube(*report.cube, opt->order) : prt::project(probe, opt->order);
+    const prt::ShLighting sh = prt::project(probe, opt->order);
     const double ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 

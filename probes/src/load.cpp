@@ -390,7 +390,9 @@ Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
       options.layout != Layout::kAngular && options.layout != Layout::kCross) {
     r.layout = Layout::kFaces;
     r.cube = std::make_shared<const CubeMap>(read_face_set(path, &r));
-    return cube_to_latlong(*r.cube, path.filename().string());
+    Probe probe = cube_to_latlong(*r.cube, path.filename().string());
+    probe.set_source_cube(r.cube);
+    return probe;
   }
   Image image = read_image(path);
   r.format = image.format;
@@ -406,7 +408,9 @@ Probe load_probe(const std::filesystem::path& path, const LoadOptions& options,
       r.cross = image.width > image.height ? CrossKind::kHorizontal : CrossKind::kVertical;
       r.cube = std::make_shared<const CubeMap>(
           cube_from_cross(image.rgb, image.width, image.height, r.cross));
-      return cube_to_latlong(*r.cube, name);
+      Probe probe = cube_to_latlong(*r.cube, name);
+      probe.set_source_cube(r.cube);
+      return probe;
     }
     default:
       return Probe(image.width, image.height, std::move(image.rgb), name);

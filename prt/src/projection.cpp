@@ -1,5 +1,7 @@
 #include "prt/projection.h"
 
+#include "prt/cube_projection.h"
+
 #include "prt/sh.h"
 
 #include <tbb/blocked_range.h>
@@ -12,6 +14,11 @@
 namespace prt {
 
 ShLighting project(const probes::Probe& probe, int order) {
+  if (probe.source_cube()) return project_cube(*probe.source_cube(), order);
+  return project_latlong(probe, order);
+}
+
+ShLighting project_latlong(const probes::Probe& probe, int order) {
   check_order(order, "projection order");
   if (probe.width() <= 0 || probe.height() <= 0) {
     throw std::invalid_argument("project: probe '" + probe.name() + "' is empty");

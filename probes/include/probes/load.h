@@ -12,7 +12,8 @@
 //    files -- a folder holding px, nx, py, ny, pz, nz (any image format, e.g. px.exr), or a
 //    path with "{face}" standing for those names (sky_{face}.hdr). The renderer samples
 //    lat-long maps, so a cube of face size N is resampled (bilinear) to a 4N x 2N lat-long
-//    map on load; the cube itself is kept in the report for an exact SH projection.
+//    map on load; the cube itself rides along (Probe::source_cube, and the report) for an
+//    exact SH projection.
 //
 // Bad texels: NaN or Inf refuses the file (the map is corrupt and no fix is safe); negative
 // values, which some HDR tools leave after filtering, are clamped to 0 and counted.

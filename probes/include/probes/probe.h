@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +30,8 @@ using Rgb = Eigen::Vector3f;
 // Map from the unit square to directions and back (see the convention above).
 Eigen::Vector3d latlong_direction(double u, double v);
 Eigen::Vector2d latlong_uv(const Eigen::Vector3d& direction);  // direction need not be unit
+
+class CubeMap;
 
 class Probe {
  public:
@@ -59,11 +62,18 @@ class Probe {
   // Integral of radiance over the sphere divided by 4 pi (solid-angle weighted mean).
   Rgb mean_radiance() const;
 
+  // A probe read from a cube map is the cube's lat-long resampling (what lookups and the
+  // background use); the cube itself rides along so that SH projection can integrate its own
+  // texels exactly instead of the resampling (prt::project).
+  const CubeMap* source_cube() const { return cube_.get(); }
+  void set_source_cube(std::shared_ptr<const CubeMap> cube) { cube_ = std::move(cube); }
+
  private:
   int width_ = 0;
   int height_ = 0;
   std::vector<Rgb> rgb_;
   std::string name_;
+  std::shared_ptr<const CubeMap> cube_;
 };
 
 class ProbeError : public std::runtime_error {

@@ -16,7 +16,12 @@ namespace prt {
 
 using ShLighting = Eigen::Matrix<double, Eigen::Dynamic, 3>;
 
+// A probe that carries its source cube map (probes::Probe::source_cube) is projected over the
+// cube's texels with their exact solid angles (prt/cube_projection.h); any other over its
+// lat-long pixels.
 ShLighting project(const probes::Probe& probe, int order);
+// The lat-long integration alone, even for a probe resampled from a cube map.
+ShLighting project_latlong(const probes::Probe& probe, int order);
 
 // A lat-long probe whose texels are the SH expansion of `lighting` at pixel centres
 // (negative values kept: the result is a signed function, not a physical probe).
