@@ -174,6 +174,11 @@ if [[ -f $forest ]]; then
     skip "overdraw plot (python3-matplotlib is not installed)"
     [[ $out == *"apt-get install python3-matplotlib"* ]]; check "overdraw: says how to get the plot" $?
   fi
+  # Pipeline statistics of each row: every referenced vertex is shaded at least once, and every
+  # triangle the cost model counts is submitted.
+  read -r vs_per_vertex prims drawn < <(jget "$tmp/od/overdraw.json" /rows/3/vs_per_referenced_vertex /rows/3/primitives /rows/3/triangles_drawn | tr '\n' ' ')
+  awk -v v="$vs_per_vertex" -v p="$prims" -v d="$drawn" 'BEGIN { exit !(v >= 1 && p >= d && d > 0) }'
+  check "overdraw: row work counters (VS per vertex $vs_per_vertex >= 1, primitives $prims >= drawn $drawn)" $?
   run "${od[@]}" --json; expect_code 0 && [[ $(jget - /rows/0/clusters <<<"$out") == 2 ]]; check "overdraw --json: stdout parses" $?
   ls "$tmp"/od/overdraw-K4-original-*-thesis.png >/dev/null 2>&1; check "overdraw: wrote the K=4 overdraw picture" $?
   run "${od[@]}"; expect_code 0 && [[ $out == *"(cached: "* && $out == *"came from the cache"* ]]; check "overdraw: second run uses the cached bake and compressions" $?

@@ -86,15 +86,16 @@ std::string markdown_tables(const OverdrawReport& r) {
              std::to_string(first->passes) + " passes)\n\n";
       out +=
           "| method | strategy | clustering time | average overdraw | FPS | Average SE | "
-          "image RMSE (rel.) |\n";
-      out += "| --- | --- | ---: | ---: | ---: | ---: | ---: |\n";
+          "image RMSE (rel.) | VS invocations per vertex |\n";
+      out += "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
       for (const OverdrawRow& row : r.rows) {
         if (row.budget != budget || std::to_string(row.clusters) != k) continue;
         out += "| " + row.method + " | " + row.strategy + " | " +
                format_duration(row.clustering_seconds) + " | " +
                format("%.6f", row.average_overdraw) + " | " + format("%.2f", row.fps) + " | " +
                format("%.6f", row.average_se) + " | " + format("%.4g", row.image_rmse) + " (" +
-               format("%.2f%%", 100.0 * row.image_rmse_relative) + ") |\n";
+               format("%.2f%%", 100.0 * row.image_rmse_relative) + ") | " +
+               format("%.3f", row.vs_per_referenced_vertex) + " |\n";
       }
     }
   }
@@ -163,7 +164,7 @@ std::string csv(const OverdrawReport& r) {
       "clusters,method,budget,register_budget,clusters_per_pass,passes,strategy,"
       "clustering_seconds,grouping_seconds,average_overdraw,triangles_drawn,triangles,fps,"
       "frame_ms,cpu_ms,gl_ms,average_se,relative_error,image_rmse,image_rmse_relative,"
-      "multi_cluster_triangles\n";
+      "multi_cluster_triangles,vs_invocations,primitives,vs_per_referenced_vertex\n";
   for (const OverdrawRow& x : r.rows) {
     out += std::to_string(x.clusters) + "," + csv_field(x.method) + "," + csv_field(x.budget) +
            "," + std::to_string(x.register_budget) + "," + std::to_string(x.clusters_per_pass) +
@@ -175,7 +176,8 @@ std::string csv(const OverdrawReport& r) {
            format("%.4f", x.gl_ms) + "," + format("%.9g", x.average_se) + "," +
            format("%.9g", x.relative_error) + "," + format("%.9g", x.image_rmse) + "," +
            format("%.9g", x.image_rmse_relative) + "," + format("%.9g", x.multi_cluster_triangles) +
-           "\n";
+           "," + std::to_string(x.vs_invocations) + "," + std::to_string(x.primitives) + "," +
+           format("%.6f", x.vs_per_referenced_vertex) + "\n";
   }
   return out;
 }
@@ -202,7 +204,10 @@ std::string json(const OverdrawReport& r) {
                     {"relative_error", x.relative_error},
                     {"image_rmse", x.image_rmse},
                     {"image_rmse_relative", x.image_rmse_relative},
-                    {"multi_cluster_triangles", x.multi_cluster_triangles}});
+                    {"multi_cluster_triangles", x.multi_cluster_triangles},
+                    {"vs_invocations", x.vs_invocations},
+                    {"primitives", x.primitives},
+                    {"vs_per_referenced_vertex", x.vs_per_referenced_vertex}});
   Json modes = Json::array();
   for (const ModeTiming& m : r.modes)
     modes.push_back({{"clusters", m.clusters},

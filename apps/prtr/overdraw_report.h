@@ -28,6 +28,10 @@ struct OverdrawRow {
   double average_se = 0, relative_error = 0;
   double image_rmse = 0, image_rmse_relative = 0;  // against the uncompressed render
   double multi_cluster_triangles = 0;              // share of triangles spanning clusters
+  // One counted frame's pipeline statistics (render::WorkTotals): deterministic work beside
+  // the noisy FPS; vs_per_referenced_vertex is 1 when the driver shades each vertex once.
+  std::uint64_t vs_invocations = 0, primitives = 0;
+  double vs_per_referenced_vertex = 0;
 };
 
 // FPS of the other render modes per K (the original CPCA set), for "what the overdraw costs".

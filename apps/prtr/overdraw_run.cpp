@@ -265,6 +265,10 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   r.set_background(kBlack);
   const render::TimingSummary t = time_frames(r, s, s.plan.frames, s.plan.warmup);
   check_counts(r.stats(), od, c.label() + ", " + strategy + ", budget " + std::to_string(budget));
+  r.set_count_work(true);  // one counted frame, outside the timed ones
+  r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
+  const render::WorkTotals work = render::work_totals(r.stats().pass_work);
+  r.set_count_work(false);
   const ImageDifference e = image_error(final_image(r, s), s.reference);
 
   OverdrawRow row;
@@ -288,6 +292,9 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   row.image_rmse = e.rmse;
   row.image_rmse_relative = e.relative();
   row.multi_cluster_triangles = c.multi_cluster_triangles;
+  row.vs_invocations = work.vs_invocations;
+  row.primitives = work.primitives;
+  row.vs_per_referenced_vertex = work.vs_per_referenced_vertex;
   *groups_out = groups;
   return row;
 }
