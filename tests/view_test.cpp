@@ -230,7 +230,7 @@ TEST(ViewEncode, ToneMapMatchesRenderToneMapExactly) {
     image.rgba.resize(std::size_t(image.width) * image.height * 4);
     for (std::size_t i = 0; i < image.rgba.size(); ++i)
       image.rgba[i] = i % 97 == 0 ? -1.f : std::exp2(log_value(rng));
-    const std::vector<std::uint8_t> rgb = prtr_app::tone_map_rgb8(image, exposure);
+    const std::vector<std::uint8_t> rgb = render::tone_map_rgb8(image, exposure);
     int mismatches = 0;
     for (std::size_t p = 0; p < std::size_t(image.width) * image.height; ++p)
       for (int c = 0; c < 3; ++c) {

@@ -13,10 +13,6 @@
 
 namespace prtr_app {
 
-// render::tone_map per channel, within one 8-bit code of lround(255 * tone_map) (the sRGB
-// step is a table). RGB, row 0 at the top.
-std::vector<std::uint8_t> tone_map_rgb8(const render::Image& image, double exposure);
-
 // The colour overlay pictures are drawn on where nothing is: composite_overlay leaves those
 // pixels alone.
 inline constexpr render::Colour8 kOverlayTransparent{255, 0, 255};

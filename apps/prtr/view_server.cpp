@@ -74,7 +74,7 @@ void send_frame(const FramePtr& frame, httplib::Response& res) {
   }
   std::call_once(frame->encoded, [&] {
     const auto start = Clock::now();
-    std::vector<std::uint8_t> rgb = tone_map_rgb8(frame->image, frame->state.exposure);
+    std::vector<std::uint8_t> rgb = render::tone_map_rgb8(frame->image, frame->state.exposure);
     if (frame->overlay)
       composite_overlay(rgb, frame->image.width, frame->image.height, *frame->overlay, 0.65);
     frame->jpeg = encode_jpeg(rgb, frame->image.width, frame->image.height);

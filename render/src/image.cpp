@@ -76,10 +76,7 @@ void write_png(const std::filesystem::path& path, const Image& image, double exp
   if (image.width < 1 || image.height < 1 ||
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
     throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
-  std::vector<std::uint8_t> rgb(std::size_t(image.width) * image.height * 3);
-  for (std::size_t p = 0; p < std::size_t(image.width) * image.height; ++p)
-    for (int c = 0; c < 3; ++c)
-      rgb[p * 3 + c] = std::uint8_t(std::lround(255.f * tone_map(image.rgba[p * 4 + c], exposure)));
+  const std::vector<std::uint8_t> rgb = tone_map_rgb8(image, exposure);
   OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
   write_atomically(path, spec, rgb.data(), "PNG");
 }

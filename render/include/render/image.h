@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <vector>
@@ -42,6 +43,11 @@ void write_png(const std::filesystem::path& path, const Image& image, double exp
 
 // The tone map above for one linear value, before quantisation (for tests and previews).
 float tone_map(float linear, double exposure);
+
+// The whole image through the tone map, 8 bits per channel, RGB, row 0 first: exactly
+// lround(255 * tone_map) per channel, found in a threshold table instead of a pow per
+// channel (write_png and prtr view's frames both use it).
+std::vector<std::uint8_t> tone_map_rgb8(const Image& image, double exposure);
 
 // Reads any image OpenImageIO understands into RGBA floats (missing alpha -> 1), for tests
 // and comparisons.
