@@ -1,12 +1,14 @@
 // prtr overdraw MESH --probe PROBE: the overdraw benchmark (apps/prtr/overdraw_run.h), which
 // reproduces the thesis's tables 5.2-5.17 (ch. 5) on our meshes. This file only turns flags
 // into a plan and writes the report: Markdown or JSON on stdout, CSV and JSON in --out (the
-// run itself writes the cluster and overdraw pictures there), then has
-// scripts/plot_overdraw.py draw the plot from the CSV when python3-matplotlib is installed.
+// run itself writes the cluster and overdraw pictures there), draws the Pareto and timing
+// plots (overdraw_plot.h), then has scripts/plot_overdraw.py draw the per-K plot from the CSV
+// when python3-matplotlib is installed.
 #include "bake_flags.h"
 #include "commands.h"
 #include "compress_flags.h"
 #include "flag_checks.h"
+#include "overdraw_plot.h"
 #include "overdraw_run.h"
 #include "pipeline.h"
 #include "progress_bar.h"
@@ -15,10 +17,12 @@
 #include "common/atomic_file.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
+#include "render/false_colour.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,10 +33,10 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string mesh, probe, transfer, cache, out = "out/overdraw";
+  std::string mesh, probe, transfer, cache, out = "out/overdraw", pareto_plot, timing_plot;
   std::string clusters = "64,128,192,256", rows = "original,overdraw-reduction,coherence,both";
   std::string strategies = "order,greedy,greedy-refine,metis,ils", budgets = "default,thesis";
-  int frames = 10, warmup = 2, width = 1280, height = 948;
+  int frames = 10, warmup = 2, rounds = 3, width = 1280, height = 948;
   double degrees_per_frame = 1.0;
   BakeFlags bake;
   CompressFlags compress;
@@ -93,7 +97,12 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--frames", o.frames, "Timed frames per configuration (FPS = median)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("--warmup", o.warmup, "Untimed frames first")
+  cmd->add_option("--rounds", o.rounds,
+                  "Timing rounds, each visiting every row in turn for --warmup + --frames "
+                  "frames (FPS = median over all rounds, with the interquartile range)")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  cmd->add_option("--warmup", o.warmup, "Untimed frames first (every round)")
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   cmd->add_option("--degrees-per-frame", o.degrees_per_frame,
@@ -108,6 +117,12 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--out", o.out, "Directory for CSV, JSON, plot and pictures")
       ->capture_default_str();
+  cmd->add_option("--plot", o.pareto_plot,
+                  "Pareto plot PNG: Average SE vs overdraw per K, every row, thesis's best "
+                  "marked (default OUT/overdraw-pareto.png)");
+  cmd->add_option("--timing-plot", o.timing_plot,
+                  "GL ms and FPS vs overdraw PNG with the fitted lines (default "
+                  "OUT/overdraw-timing.png)");
   cmd->add_flag("--no-modes", o.no_modes, "Skip the single-pass/decoupled/uncompressed timings");
   cmd->add_flag("--json", o.json, "Print the JSON report on stdout instead of the tables");
   cmd->add_flag("-q,--quiet", o.quiet, "No progress on stderr");
@@ -141,6 +156,7 @@ OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
   plan.compress = resolve_compress_flags(o.compress);
   plan.frames = o.frames;
   plan.warmup = o.warmup;
+  plan.rounds = o.rounds;
   plan.width = o.width;
   plan.height = o.height;
   plan.degrees_per_frame = o.degrees_per_frame;
@@ -177,22 +193,43 @@ std::string plot(const fs::path& csv_path, const std::string& budget) {
   return "plot " + png.string();
 }
 
-void write_outputs(const OverdrawReport& report, const OverdrawPlan& plan, bool as_json) {
+// The Pareto plot of the plot budget (the thesis's best marked on the thesis budget) and the
+// timing plot; returns their paths for the closing line.
+std::string write_plots(const OverdrawReport& report, const OverdrawPlan& plan, const Options& o) {
   const fs::path out = plan.pictures;
-  const std::string csv_text = csv(report), json_text = json(report);
+  const fs::path pareto =
+      o.pareto_plot.empty() ? out / "overdraw-pareto.png" : fs::path(o.pareto_plot);
+  const fs::path timing =
+      o.timing_plot.empty() ? out / "overdraw-timing.png" : fs::path(o.timing_plot);
+  const std::string budget = plot_budget(plan.budgets);
+  render::write_picture_png(
+      pareto, pareto_plot(report, budget,
+                          budget == "thesis" ? thesis_best_overdraw() : std::map<int, double>{}));
+  render::write_picture_png(timing, timing_plot(report));
+  return pareto.string() + " and " + timing.string();
+}
+
+void write_outputs(const OverdrawReport& report, const OverdrawPlan& plan, const Options& o) {
+  const bool as_json = o.json;
+  const fs::path out = plan.pictures;
+  const std::string csv_text = csv(report), json_text = json(report), fit_text = fit_csv(report);
   common::write_file_atomically(out / "overdraw.csv", csv_text.data(), csv_text.size());
+  common::write_file_atomically(out / "overdraw-fit.csv", fit_text.data(), fit_text.size());
   common::write_file_atomically(out / "overdraw.json", json_text.data(), json_text.size());
+  const std::string plots = write_plots(report, plan, o);
   const std::string plotted = plot(out / "overdraw.csv", plot_budget(plan.budgets));
   if (as_json) {
     std::fputs(json_text.c_str(), stdout);
-    if (!plan.quiet) std::fprintf(stderr, "overdraw: %s\n", plotted.c_str());
+    if (!plan.quiet)
+      std::fprintf(stderr, "overdraw: plots %s; %s\n", plots.c_str(), plotted.c_str());
     return;
   }
   std::fputs(markdown(report).c_str(), stdout);
   std::printf(
-      "\nWrote %s/overdraw.csv, overdraw.json and the K=%d cluster and overdraw pictures; %s\n",
+      "\nWrote %s/overdraw.csv, overdraw-fit.csv, overdraw.json and the K=%d cluster and "
+      "overdraw pictures; plots %s; %s\n",
       out.string().c_str(), *std::max_element(plan.clusters.begin(), plan.clusters.end()),
-      plotted.c_str());
+      plots.c_str(), plotted.c_str());
 }
 
 }  // namespace
@@ -223,7 +260,7 @@ Runner add_overdraw_command(CLI::App& app) {
       throw UsageError(e.what());
     }
     bar->finish();
-    write_outputs(report, plan, opt->json);
+    write_outputs(report, plan, *opt);
   };
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <utility>
 
 namespace prtr_app {
 namespace {
@@ -52,10 +53,12 @@ std::string markdown_preamble(const OverdrawReport& r) {
          r.transfer + ")\n";
   out += "Order " + std::to_string(r.order) + ", " + std::to_string(r.pcs) +
          " PCs: " + std::to_string(r.registers_per_cluster) + " vec4 registers per cluster. " +
-         std::to_string(r.width) + " x " + std::to_string(r.height) + ", FPS = median of " +
-         std::to_string(r.frames) + " frames after " + std::to_string(r.warmup) +
-         " warm-up, environment rotating " + format("%g", r.degrees_per_frame) +
-         " deg/frame about +Y; " + r.gl_renderer + ".\n";
+         std::to_string(r.width) + " x " + std::to_string(r.height) +
+         ", FPS and GL ms = median (interquartile range) of " + std::to_string(r.frames) +
+         " frames after " + std::to_string(r.warmup) + " warm-up in each of " +
+         std::to_string(r.rounds) +
+         " rounds taken round-robin over the rows, environment rotating " +
+         format("%g", r.degrees_per_frame) + " deg/frame about +Y; " + r.gl_renderer + ".\n";
   out += "Image RMSE: multipass render vs the uncompressed render, environment rotated " +
          format("%g", r.image_rotation_degrees) +
          " deg, over covered pixels; in brackets relative to the reference's RMS.\n";
@@ -64,6 +67,35 @@ std::string markdown_preamble(const OverdrawReport& r) {
         "Some compressions came from the cache; their clustering times are those measured "
         "when they were made.\n";
   return out;
+}
+
+std::string with_iqr(double median, const Spread& s, const char* fmt) {
+  return format(fmt, median) + " (" + format(fmt, s.iqr()) + ")";
+}
+
+std::string table_row(const OverdrawRow& row) {
+  return "| " + row.method + " | " + row.strategy + " | " +
+         format_duration(row.clustering_seconds) + " | " + format("%.6f", row.average_overdraw) +
+         " | " + with_iqr(row.fps, row.fps_spread, "%.2f") + " | " +
+         with_iqr(row.gl_ms, row.gl_ms_spread, "%.1f") + " | " + format("%.6f", row.average_se) +
+         " | " + format("%.4g", row.image_rmse) + " (" +
+         format("%.2f%%", 100.0 * row.image_rmse_relative) + ") | " +
+         std::to_string(row.vs_invocations) + " | " + std::to_string(row.primitives) + " | " +
+         format("%.3f", row.vs_per_referenced_vertex) + " |\n";
+}
+
+std::string describe_fit(const char* what, const LineFit& f) {
+  return std::string(what) + " = " + format("%.4g", f.slope) + " x overdraw " +
+         (f.intercept < 0 ? "- " : "+ ") + format("%.4g", std::abs(f.intercept)) +
+         ", R^2 = " + format("%.3f", f.r2);
+}
+
+// The least-squares lines of GL time and FPS against overdraw over every row.
+std::string markdown_fits(const OverdrawReport& r) {
+  if (r.gl_fit.points == 0) return "";
+  return "\nAcross all " + std::to_string(r.gl_fit.points) +
+         " rows (least squares on the medians): " + describe_fit("GL ms", r.gl_fit) + "; " +
+         describe_fit("FPS", r.fps_fit) + ".\n";
 }
 
 // Per budget and K, one table in the thesis's column order.
@@ -85,18 +117,11 @@ std::string markdown_tables(const OverdrawReport& r) {
              std::to_string(first->clusters_per_pass) + " clusters per pass, " +
              std::to_string(first->passes) + " passes)\n\n";
       out +=
-          "| method | strategy | clustering time | average overdraw | FPS | Average SE | "
-          "image RMSE (rel.) | VS invocations per vertex |\n";
-      out += "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
-      for (const OverdrawRow& row : r.rows) {
-        if (row.budget != budget || std::to_string(row.clusters) != k) continue;
-        out += "| " + row.method + " | " + row.strategy + " | " +
-               format_duration(row.clustering_seconds) + " | " +
-               format("%.6f", row.average_overdraw) + " | " + format("%.2f", row.fps) + " | " +
-               format("%.6f", row.average_se) + " | " + format("%.4g", row.image_rmse) + " (" +
-               format("%.2f%%", 100.0 * row.image_rmse_relative) + ") | " +
-               format("%.3f", row.vs_per_referenced_vertex) + " |\n";
-      }
+          "| method | strategy | clustering time | average overdraw | FPS (IQR) | GL ms (IQR) | "
+          "Average SE | image RMSE (rel.) | VS invocations | primitives | VS per vertex |\n";
+      out += "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+      for (const OverdrawRow& row : r.rows)
+        if (row.budget == budget && std::to_string(row.clusters) == k) out += table_row(row);
     }
   }
   return out;
@@ -156,7 +181,26 @@ std::string markdown_modes(const OverdrawReport& r) {
 }  // namespace
 
 std::string markdown(const OverdrawReport& r) {
-  return markdown_preamble(r) + markdown_tables(r) + markdown_modes(r);
+  return markdown_preamble(r) + markdown_tables(r) + markdown_fits(r) + markdown_modes(r);
+}
+
+void fit_timings(OverdrawReport& r) {
+  std::vector<double> overdraw, gl, fps;
+  for (const OverdrawRow& row : r.rows) {
+    overdraw.push_back(row.average_overdraw);
+    gl.push_back(row.gl_ms);
+    fps.push_back(row.fps);
+  }
+  r.gl_fit = fit_line(overdraw, gl);
+  r.fps_fit = fit_line(overdraw, fps);
+}
+
+std::string fit_csv(const OverdrawReport& r) {
+  std::string out = "quantity,slope,intercept,r2,points\n";
+  for (const auto& [name, f] : {std::pair{"gl_ms", r.gl_fit}, std::pair{"fps", r.fps_fit}})
+    out += std::string(name) + "," + format("%.9g", f.slope) + "," + format("%.9g", f.intercept) +
+           "," + format("%.9g", f.r2) + "," + std::to_string(f.points) + "\n";
+  return out;
 }
 
 std::string csv(const OverdrawReport& r) {
@@ -164,7 +208,8 @@ std::string csv(const OverdrawReport& r) {
       "clusters,method,budget,register_budget,clusters_per_pass,passes,strategy,"
       "clustering_seconds,grouping_seconds,average_overdraw,triangles_drawn,triangles,fps,"
       "frame_ms,cpu_ms,gl_ms,average_se,relative_error,image_rmse,image_rmse_relative,"
-      "multi_cluster_triangles,vs_invocations,primitives,vs_per_referenced_vertex\n";
+      "multi_cluster_triangles,vs_invocations,primitives,vs_per_referenced_vertex,fps_q1,fps_q3,"
+      "gl_ms_q1,gl_ms_q3\n";
   for (const OverdrawRow& x : r.rows) {
     out += std::to_string(x.clusters) + "," + csv_field(x.method) + "," + csv_field(x.budget) +
            "," + std::to_string(x.register_budget) + "," + std::to_string(x.clusters_per_pass) +
@@ -177,10 +222,22 @@ std::string csv(const OverdrawReport& r) {
            format("%.9g", x.relative_error) + "," + format("%.9g", x.image_rmse) + "," +
            format("%.9g", x.image_rmse_relative) + "," + format("%.9g", x.multi_cluster_triangles) +
            "," + std::to_string(x.vs_invocations) + "," + std::to_string(x.primitives) + "," +
-           format("%.6f", x.vs_per_referenced_vertex) + "\n";
+           format("%.6f", x.vs_per_referenced_vertex) + "," + format("%.4f", x.fps_spread.q1) +
+           "," + format("%.4f", x.fps_spread.q3) + "," + format("%.4f", x.gl_ms_spread.q1) + "," +
+           format("%.4f", x.gl_ms_spread.q3) + "\n";
   }
   return out;
 }
+
+namespace {
+Json fit_json(const OverdrawReport& r) {
+  Json fits = Json::object();
+  for (const auto& [name, f] : {std::pair{"gl_ms", r.gl_fit}, std::pair{"fps", r.fps_fit}})
+    fits[name] = {
+        {"slope", f.slope}, {"intercept", f.intercept}, {"r2", f.r2}, {"points", f.points}};
+  return fits;
+}
+}  // namespace
 
 std::string json(const OverdrawReport& r) {
   Json rows = Json::array();
@@ -207,7 +264,11 @@ std::string json(const OverdrawReport& r) {
                     {"multi_cluster_triangles", x.multi_cluster_triangles},
                     {"vs_invocations", x.vs_invocations},
                     {"primitives", x.primitives},
-                    {"vs_per_referenced_vertex", x.vs_per_referenced_vertex}});
+                    {"vs_per_referenced_vertex", x.vs_per_referenced_vertex},
+                    {"fps_q1", x.fps_spread.q1},
+                    {"fps_q3", x.fps_spread.q3},
+                    {"gl_ms_q1", x.gl_ms_spread.q1},
+                    {"gl_ms_q3", x.gl_ms_spread.q3}});
   Json modes = Json::array();
   for (const ModeTiming& m : r.modes)
     modes.push_back({{"clusters", m.clusters},
@@ -231,6 +292,8 @@ std::string json(const OverdrawReport& r) {
                        {"height", r.height},
                        {"frames", r.frames},
                        {"warmup", r.warmup},
+                       {"rounds", r.rounds},
+                       {"fits", fit_json(r)},
                        {"degrees_per_frame", r.degrees_per_frame},
                        {"image_rotation_degrees", r.image_rotation_degrees},
                        {"gl_renderer", r.gl_renderer},

@@ -18,7 +18,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <filesystem>
+#include <memory>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -244,7 +246,33 @@ void check_counts(const render::RenderStats& stats, const cpca::OverdrawStats& o
       " passes; this is a bug in the renderer or the cost model");
 }
 
-// One table row: a compression grouped by one strategy under one budget, rendered multipass.
+// A row's multipass renderer; every timing round builds it anew, so no row keeps GL memory
+// (or a warm cache) between its turns.
+std::unique_ptr<render::Renderer> multipass_renderer(const Scene& s, const Compression& c,
+                                                     int budget, int per_pass,
+                                                     const cpca::SuperClusters& groups) {
+  render::RendererOptions ro;
+  ro.mode = render::Mode::kMultipass;
+  ro.register_budget = budget;
+  ro.clusters_per_pass = per_pass;
+  ro.groups = groups;
+  ro.count_primitives = true;  // same for every row: one query per pass
+  auto r = std::make_unique<render::Renderer>(s.mesh, &c.set, nullptr, &s.probe, ro);
+  r->set_background(kBlack);
+  return r;
+}
+
+// What the timing rounds need to rebuild a measured row's renderer.
+struct TimedRow {
+  const Compression* compression = nullptr;
+  cpca::SuperClusters groups;
+  int budget = 0, per_pass = 0;
+  std::size_t row = 0;  // index into OverdrawReport::rows
+  std::vector<double> frame_ms, cpu_ms, gl_ms;
+};
+
+// One table row without its timing: a compression grouped by one strategy under one budget,
+// rendered multipass once for the GL counts, the work counters and the image.
 OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string& budget_name,
                         int budget, int per_pass, const std::string& strategy,
                         cpca::SuperClusters* groups_out) {
@@ -255,21 +283,14 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
       std::chrono::duration<double>(std::chrono::steady_clock::now() - g0).count();
   const cpca::OverdrawStats od = cpca::overdraw(c.set.cluster_of, s.geometry.triangles, groups);
 
-  render::RendererOptions ro;
-  ro.mode = render::Mode::kMultipass;
-  ro.register_budget = budget;
-  ro.clusters_per_pass = per_pass;
-  ro.groups = groups;
-  ro.count_primitives = true;  // same for every row: one query per pass
-  render::Renderer r(s.mesh, &c.set, nullptr, &s.probe, ro);
-  r.set_background(kBlack);
-  const render::TimingSummary t = time_frames(r, s, s.plan.frames, s.plan.warmup);
-  check_counts(r.stats(), od, c.label() + ", " + strategy + ", budget " + std::to_string(budget));
-  r.set_count_work(true);  // one counted frame, outside the timed ones
-  r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
-  const render::WorkTotals work = render::work_totals(r.stats().pass_work);
-  r.set_count_work(false);
-  const ImageDifference e = image_error(final_image(r, s), s.reference);
+  const auto r = multipass_renderer(s, c, budget, per_pass, groups);
+  r->render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
+  check_counts(r->stats(), od, c.label() + ", " + strategy + ", budget " + std::to_string(budget));
+  r->set_count_work(true);
+  r->render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
+  const render::WorkTotals work = render::work_totals(r->stats().pass_work);
+  r->set_count_work(false);
+  const ImageDifference e = image_error(final_image(*r, s), s.reference);
 
   OverdrawRow row;
   row.clusters = c.k;
@@ -283,10 +304,6 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   row.grouping_seconds = grouping_seconds;
   row.average_overdraw = od.average_overdraw;
   row.triangles_drawn = od.triangles_drawn;
-  row.fps = t.fps;
-  row.frame_ms = t.frame_ms_median;
-  row.cpu_ms = t.cpu_ms_median;
-  row.gl_ms = t.gl_ms_median;
   row.average_se = c.summary.average_se;
   row.relative_error = c.summary.relative_error;
   row.image_rmse = e.rmse;
@@ -297,6 +314,44 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   row.vs_per_referenced_vertex = work.vs_per_referenced_vertex;
   *groups_out = groups;
   return row;
+}
+
+// One turn of one row: warm-up + frames frames, the environment rotating from the same start
+// in every turn, so every row and round renders the same frames.
+void time_turn(const Scene& s, TimedRow& t) {
+  const auto r = multipass_renderer(s, *t.compression, t.budget, t.per_pass, t.groups);
+  for (int f = 0; f < s.plan.warmup + s.plan.frames; ++f) {
+    const double radians = s.plan.degrees_per_frame * f * std::numbers::pi / 180.0;
+    const render::FrameTiming timing =
+        r->render(s.camera, s.lighting, prt::axis_angle(s.axis, radians));
+    if (f < s.plan.warmup) continue;
+    t.frame_ms.push_back(timing.total_ms);
+    t.cpu_ms.push_back(timing.cpu_ms);
+    t.gl_ms.push_back(timing.gl_ms);
+  }
+}
+
+// The interleaved timing rounds, then each row's medians and quartiles and the run's fits.
+void time_rows(const Scene& s, std::vector<TimedRow>& timed, OverdrawReport& report) {
+  for (int round = 0; round < s.plan.rounds; ++round) {
+    note(s.plan, "timing round " + std::to_string(round + 1) + " of " +
+                     std::to_string(s.plan.rounds) + " over " + std::to_string(timed.size()) +
+                     " rows");
+    for (TimedRow& t : timed) time_turn(s, t);
+  }
+  for (const TimedRow& t : timed) {
+    OverdrawRow& row = report.rows[t.row];
+    std::vector<double> fps;
+    for (double ms : t.frame_ms) fps.push_back(ms > 0 ? 1000.0 / ms : 0.0);
+    row.fps_spread = spread(fps);
+    row.fps = row.fps_spread.median;
+    row.frame_ms = spread(t.frame_ms).median;
+    row.cpu_ms = spread(t.cpu_ms).median;
+    row.gl_ms_spread = spread(t.gl_ms);
+    row.gl_ms = row.gl_ms_spread.median;
+  }
+  report.rounds = s.plan.rounds;
+  fit_timings(report);
 }
 
 // Counts steps for the progress callback.
@@ -310,7 +365,7 @@ struct Progress {
 
 // Every budget x strategy row of one compression; at the largest K also its pictures.
 void measure_compression(const Scene& s, const Compression& c, OverdrawReport& report,
-                         Progress& progress) {
+                         std::vector<TimedRow>& timed, Progress& progress) {
   const OverdrawPlan& plan = s.plan;
   const int cost = render::constant_layout(c.set).registers_per_cluster();
   report.registers_per_cluster = cost;
@@ -327,6 +382,7 @@ void measure_compression(const Scene& s, const Compression& c, OverdrawReport& r
       progress.show(c.label() + ": " + budget_name + " budget, " + strategy);
       cpca::SuperClusters groups;
       report.rows.push_back(measure_row(s, c, budget_name, budget, per_pass, strategy, &groups));
+      timed.push_back({&c, groups, budget, per_pass, report.rows.size() - 1, {}, {}, {}});
       ++progress.step;
       const double od = report.rows.back().average_overdraw;
       if (pictures && budget_name == picture_budget && od < best_overdraw) {
@@ -368,6 +424,8 @@ std::string plot_budget(const std::vector<std::string>& budgets) {
 }
 
 void validate(const OverdrawPlan& plan) {
+  if (plan.rounds < 1 || plan.frames < 1)
+    throw PlanError("--rounds and --frames must be at least 1");
   if (plan.clusters.empty() || plan.methods.empty() || plan.strategies.empty() ||
       plan.budgets.empty())
     throw PlanError("the plan needs clusters, methods, strategies and budgets");
@@ -411,12 +469,15 @@ OverdrawReport run_overdraw(const OverdrawPlan& plan) {
   Progress progress{plan, 0,
                     std::uint64_t(plan.clusters.size() * plan.methods.size() *
                                   (1 + plan.budgets.size() * plan.strategies.size()))};
+  std::deque<Compression> compressions;  // deque: the timed rows point into it
+  std::vector<TimedRow> timed;
   for (int k : plan.clusters) {
     for (const std::string& method_name : plan.methods) {
       const MethodPreset& method = find_method(method_name);
       progress.show("K=" + std::to_string(k) + " " + method.name + ": compression");
       bool cached = false;
-      const Compression c = compress_row(s, report.transfer, k, method, &cached);
+      const Compression& c =
+          compressions.emplace_back(compress_row(s, report.transfer, k, method, &cached));
       if (cached) report.compressions_cached = true;
       ++progress.step;
       if (plan.modes && method_name == plan.methods.front()) {
@@ -425,9 +486,10 @@ OverdrawReport run_overdraw(const OverdrawPlan& plan) {
           report.modes.push_back(measure_mode(s, c.set, k, mode));
         }
       }
-      measure_compression(s, c, report, progress);
+      measure_compression(s, c, report, timed, progress);
     }
   }
+  time_rows(s, timed, report);
   return report;
 }
 

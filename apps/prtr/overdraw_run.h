@@ -8,9 +8,13 @@
 // cached row reports what was measured), then for every register budget and super-cluster
 // strategy it measures one row: the exact average triangle overdraw (cpca::overdraw), the
 // multipass render with that grouping, a check that the triangles GL counted equal the
-// prediction (a mismatch is a bug and stops the run), FPS with the same camera and frames for
-// every row, and the image RMSE against the uncompressed render. Per K, the single-pass and
-// decoupled paths show what the overdraw costs.
+// prediction (a mismatch is a bug and stops the run), the work counters of one frame and the
+// image RMSE against the uncompressed render. Timing comes last and is interleaved: `rounds`
+// rounds, each visiting every row in turn for warm-up + frames frames, so that load from
+// other processes on a shared machine falls on all rows alike rather than on whichever rows
+// ran while it lasted; each row reports the median and quartiles of all its timed frames,
+// and the run the least-squares line of GL time and FPS against overdraw. Per K, the
+// single-pass and decoupled paths show what the overdraw costs.
 #pragma once
 
 #include "overdraw_report.h"
@@ -33,7 +37,9 @@ class PlanError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
-// One method row: the thesis's four, and iterative CPCA with both (ours).
+// One method row: the thesis's four, and iterative CPCA with both (ours). A new clustering
+// method is one more line in kMethods (overdraw_run.cpp) and, if the cache must tell it
+// apart, a field here that compress_row copies into cpca::CompressOptions.
 struct MethodPreset {
   const char* name;
   const char* summary;
@@ -57,6 +63,7 @@ struct OverdrawPlan {
   // the coherence rows' weight.
   cpca::CompressOptions compress;
   int frames = 10, warmup = 2, width = 1280, height = 948;
+  int rounds = 3;  // interleaved timing rounds over all rows
   double degrees_per_frame = 1.0, image_degrees = 37.0;
   bool modes = true;     // single-pass / decoupled / uncompressed timings
   bool quiet = true;     // no progress bar while baking
