@@ -150,7 +150,7 @@ run gl-info; expect_code 0 && [[ $out == *"Core"* || $out == *"core profile"* ]]
 if [[ -f $forest ]]; then
   od=(overdraw "$tmp/cube.obj" --probe "$forest" --order 2 --samples 32 --bounces 0
       --clusters 2,4 --pcs 2 --rows original,both --strategies order,ils --frames 1 --warmup 0
-      --width 64 --height 48 --cache "$tmp/od_cache" --out "$tmp/od" -q)
+      --rounds 2 --width 64 --height 48 --cache "$tmp/od_cache" --out "$tmp/od" -q)
   run "${od[@]}"; expect_code 0; check "overdraw: tiny run exits 0 ($err)" $?
   [[ $out == *"baked now, cached as"* ]]; check "overdraw: first run bakes and says it caches" $?
   [[ $out =~ \|\ both\ \|\ ils\ \|\ [0-9.]+\ s\ \|\ 1\.[0-9]{6}\ \| ]]; check "overdraw: a table row for both/ils" $?
@@ -158,6 +158,14 @@ if [[ -f $forest ]]; then
   rows=$(($(wc -l <"$tmp/od/overdraw.csv") - 1))
   [[ $rows == 16 ]]; check "overdraw: 2 K x 2 methods x 2 budgets x 2 strategies CSV rows (got $rows)" $?
   [[ $(jget "$tmp/od/overdraw.json" /rows/15/strategy /modes/0/mode | tr '\n' ' ') == "ils "* ]]; check "overdraw: overdraw.json parses, 16 rows" $?
+  [[ $out == *"FPS (IQR) | GL ms (IQR)"* && $out == *"in each of 2 rounds"* ]]; check "overdraw: median and IQR over 2 interleaved rounds" $?
+  [[ $out =~ Across\ all\ 16\ rows.*GL\ ms\ =.*R\^2\ =\ [0-9.]+ ]]; check "overdraw: the GL ms vs overdraw fit is printed" $?
+  [[ $(head -1 "$tmp/od/overdraw-fit.csv") == quantity,slope,intercept,r2,points && $(grep -c ',16$' "$tmp/od/overdraw-fit.csv") == 2 ]]; check "overdraw: overdraw-fit.csv has both fits over 16 rows" $?
+  [[ -n $(jget "$tmp/od/overdraw.json" /fits/gl_ms/r2) && $(jget "$tmp/od/overdraw.json" /rounds) == 2 ]]; check "overdraw: JSON carries the fits and rounds" $?
+  # PNG width and height from the IHDR chunk: 2 K panels side by side, 2 timing panels.
+  for f in overdraw-pareto.png overdraw-timing.png; do
+    [[ $(od -An -tx1 -j16 -N8 "$tmp/od/$f" | tr -d ' \n') == 00000460000001c6 ]]; check "overdraw: $f is a 1120 x 454 PNG" $?
+  done
   for f in clusters-K4-original.png clusters-K4-both.png; do
     [[ -s $tmp/od/$f ]]; check "overdraw: wrote $f" $?
   done
