@@ -24,6 +24,7 @@ packages=(
   libturbojpeg0-dev     # prtr view: JPEG frames
   chromium              # prtr view's end-to-end test drives it headless (run, not linked)
   glmark2-data blender-data
+  fonts-dejavu-core     # prtr overdraw's plots and the picture legends: DejaVu Sans via OpenImageIO
 )
 
 missing=()
