@@ -160,12 +160,12 @@ if [[ -f $forest ]]; then
   [[ $(jget "$tmp/od/overdraw.json" /rows/15/strategy /modes/0/mode | tr '\n' ' ') == "ils "* ]]; check "overdraw: overdraw.json parses, 16 rows" $?
   [[ $out == *"FPS (IQR) | GL ms (IQR)"* && $out == *"in each of 2 rounds"* ]]; check "overdraw: median and IQR over 2 interleaved rounds" $?
   [[ $out =~ Across\ all\ 16\ rows.*GL\ ms\ =.*R\^2\ =\ [0-9.]+ ]]; check "overdraw: the GL ms vs overdraw fit is printed" $?
-  [[ $(head -1 "$tmp/od/overdraw-fit.csv") == quantity,slope,intercept,r2,points && $(grep -c ',16$' "$tmp/od/overdraw-fit.csv") == 2 ]]; check "overdraw: overdraw-fit.csv has both fits over 16 rows" $?
+  [[ $(head -1 "$tmp/od/overdraw-fit.csv") == quantity,slope,intercept,r2,points && $(grep -c ',16$' "$tmp/od/overdraw-fit.csv") == 3 ]]; check "overdraw: overdraw-fit.csv has the three fits over 16 rows" $?
   [[ -n $(jget "$tmp/od/overdraw.json" /fits/gl_ms/r2) && $(jget "$tmp/od/overdraw.json" /rounds) == 2 ]]; check "overdraw: JSON carries the fits and rounds" $?
-  # PNG width and height from the IHDR chunk: 2 K panels side by side, 2 timing panels.
-  for f in overdraw-pareto.png overdraw-timing.png; do
-    [[ $(od -An -tx1 -j16 -N8 "$tmp/od/$f" | tr -d ' \n') == 00000460000001c6 ]]; check "overdraw: $f is a 1120 x 454 PNG" $?
-  done
+  # PNG width and height from the IHDR chunk: 2 K panels side by side (1120 x 454); 3 timing
+  # panels in two rows (1120 x 874).
+  [[ $(od -An -tx1 -j16 -N8 "$tmp/od/overdraw-pareto.png" | tr -d ' \n') == 00000460000001c6 ]]; check "overdraw: the Pareto plot is a 1120 x 454 PNG" $?
+  [[ $(od -An -tx1 -j16 -N8 "$tmp/od/overdraw-timing.png" | tr -d ' \n') == 000004600000036a ]]; check "overdraw: the timing plot is a 1120 x 874 PNG" $?
   for f in clusters-K4-original.png clusters-K4-both.png; do
     [[ -s $tmp/od/$f ]]; check "overdraw: wrote $f" $?
   done

@@ -102,6 +102,8 @@ OverdrawRow row(int k, const char* method, double overdraw, double se, double gl
   r.gl_ms_spread = {gl_ms, gl_ms - 1, gl_ms + 1};
   r.fps = 1000 / gl_ms;
   r.fps_spread = {r.fps, r.fps - 0.5, r.fps + 0.5};
+  r.process_cpu_ms = 2 * gl_ms;
+  r.process_cpu_spread = {2 * gl_ms, 2 * gl_ms - 2, 2 * gl_ms + 2};
   return r;
 }
 
@@ -159,9 +161,10 @@ TEST(OverdrawPlot, TimingMarkersSitOnTheirMediansBesideTheFittedLine) {
   prtr_app::fit_timings(report);
   EXPECT_NEAR(report.gl_fit.slope, 40, 1e-9);
   EXPECT_NEAR(report.gl_fit.r2, 1, 1e-12);
+  EXPECT_NEAR(report.process_cpu_fit.slope, 80, 1e-9);
   const Decoded d = write_and_decode(prtr_app::timing_plot(report), "timing.png");
   ASSERT_EQ(d.width, 1120);
-  ASSERT_EQ(d.height, 34 + 420);
+  ASSERT_EQ(d.height, 34 + 2 * 420);  // three panels: two rows of the 2-column grid
   // GL panel: y spans the medians and their quartiles (39 .. 81).
   const Mapping gl = mapping(0, 1.0, 2.0, 39, 81);
   EXPECT_EQ(d.at(gl.px(1.0), gl.py(40)), kFirstMethod);
@@ -172,6 +175,10 @@ TEST(OverdrawPlot, TimingMarkersSitOnTheirMediansBesideTheFittedLine) {
   const Mapping fps = mapping(1, 1.0, 2.0, 12.0, 25.5);
   EXPECT_EQ(d.at(fps.px(1.0), fps.py(25)), kFirstMethod);
   EXPECT_EQ(d.at(fps.px(2.0), fps.py(12.5)), kSecondMethod);
+  // Process CPU panel, below the GL panel: 2 x GL ms, quartiles +-2 (78 .. 162).
+  const Mapping cpu = mapping(2, 1.0, 2.0, 78, 162);
+  EXPECT_EQ(d.at(cpu.px(1.0), cpu.py(80)), kFirstMethod);
+  EXPECT_EQ(d.at(cpu.px(1.5), cpu.py(120)), kSecondMethod);
 }
 
 }  // namespace

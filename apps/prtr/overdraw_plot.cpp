@@ -138,27 +138,40 @@ void pareto_panel(Picture& p, int index, const std::vector<const OverdrawRow*>& 
 }
 
 // One timing panel: medians with their IQR whiskers and the fitted line.
-void timing_panel(Picture& p, int index, const OverdrawReport& report, bool gl,
+enum class Timing { kGl, kFps, kProcessCpu };
+
+const Spread& spread_of(const OverdrawRow& r, Timing t) {
+  return t == Timing::kGl    ? r.gl_ms_spread
+         : t == Timing::kFps ? r.fps_spread
+                             : r.process_cpu_spread;
+}
+
+void timing_panel(Picture& p, int index, const OverdrawReport& report, Timing which,
                   const std::vector<std::string>& methods) {
   std::vector<double> xs, ys;
   for (const OverdrawRow& r : report.rows) {
-    const Spread& s = gl ? r.gl_ms_spread : r.fps_spread;
+    const Spread& s = spread_of(r, which);
     xs.push_back(r.average_overdraw);
-    ys.insert(ys.end(), {gl ? r.gl_ms : r.fps, s.q1, s.q3});
+    ys.insert(ys.end(), {s.median, s.q1, s.q3});
   }
   const PanelAxes a = panel_axes(index, range_of(xs), range_of(ys));
-  const LineFit& f = gl ? report.gl_fit : report.fps_fit;
+  const LineFit& f = which == Timing::kGl    ? report.gl_fit
+                     : which == Timing::kFps ? report.fps_fit
+                                             : report.process_cpu_fit;
+  const char* name = which == Timing::kGl    ? "GL ms"
+                     : which == Timing::kFps ? "FPS"
+                                             : "process CPU ms";
   draw_frame(p, a,
-             std::string(gl ? "GL ms" : "FPS") + " = " + number(f.slope) + " x + " +
-                 number(f.intercept) + ", R^2 = " + number(f.r2),
+             std::string(name) + " = " + number(f.slope) + " x + " + number(f.intercept) +
+                 ", R^2 = " + number(f.r2),
              "average overdraw");
   draw_line(p, a.px(a.x.lo), a.py(f.at(a.x.lo)), a.px(a.x.hi), a.py(f.at(a.x.hi)), kGrey, area(a));
   for (const OverdrawRow& r : report.rows) {
-    const Spread& s = gl ? r.gl_ms_spread : r.fps_spread;
+    const Spread& s = spread_of(r, which);
     const Colour8 c = method_colour(index_of(methods, r.method));
     draw_line(p, a.px(r.average_overdraw), a.py(s.q1), a.px(r.average_overdraw), a.py(s.q3), c,
               area(a));
-    marker(p, a, r.average_overdraw, gl ? r.gl_ms : r.fps, c);
+    marker(p, a, r.average_overdraw, s.median, c);
   }
 }
 
@@ -225,10 +238,11 @@ render::Picture pareto_plot(const OverdrawReport& report, const std::string& bud
 render::Picture timing_plot(const OverdrawReport& report) {
   if (report.rows.empty()) throw std::invalid_argument("timing_plot: the report has no rows");
   const std::vector<std::string> methods = methods_of(report.rows);
-  Picture p = canvas(2);
-  legend(p, "Multipass time vs overdraw, all rows", methods);
-  timing_panel(p, 0, report, true, methods);
-  timing_panel(p, 1, report, false, methods);
+  Picture p = canvas(3);
+  legend(p, "Multipass time vs overdraw, all rows (median, IQR)", methods);
+  timing_panel(p, 0, report, Timing::kGl, methods);
+  timing_panel(p, 1, report, Timing::kFps, methods);
+  timing_panel(p, 2, report, Timing::kProcessCpu, methods);
   return p;
 }
 

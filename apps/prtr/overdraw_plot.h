@@ -4,9 +4,9 @@
 //    one marker per measured row (colour = method), the rows no other row beats on both
 //    axes joined by a line, and the thesis's published best overdraw at that K as a dashed
 //    vertical line;
-//  - the timing plot: GL ms and FPS against average overdraw for every row, with the
-//    interquartile range as a whisker and the least-squares line (OverdrawReport::gl_fit,
-//    fps_fit) with its R^2.
+//  - the timing plot: GL ms, FPS and process CPU ms against average overdraw for every row,
+//    the median as a marker, the interquartile range as a whisker and the least-squares line
+//    (OverdrawReport::gl_fit, fps_fit, process_cpu_fit) with its R^2.
 // The geometry is public so that a test can find a marker from the data alone.
 #pragma once
 
@@ -58,7 +58,7 @@ const std::map<int, double>& thesis_best_overdraw();
 // std::invalid_argument when no row has that budget.
 render::Picture pareto_plot(const OverdrawReport& report, const std::string& budget,
                             const std::map<int, double>& thesis);
-// Two panels (GL ms, FPS) over every row of the report.
+// Three panels (GL ms, FPS, process CPU ms) over every row of the report.
 render::Picture timing_plot(const OverdrawReport& report);
 
 }  // namespace prtr_app

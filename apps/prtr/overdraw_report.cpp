@@ -77,8 +77,9 @@ std::string table_row(const OverdrawRow& row) {
   return "| " + row.method + " | " + row.strategy + " | " +
          format_duration(row.clustering_seconds) + " | " + format("%.6f", row.average_overdraw) +
          " | " + with_iqr(row.fps, row.fps_spread, "%.2f") + " | " +
-         with_iqr(row.gl_ms, row.gl_ms_spread, "%.1f") + " | " + format("%.6f", row.average_se) +
-         " | " + format("%.4g", row.image_rmse) + " (" +
+         with_iqr(row.gl_ms, row.gl_ms_spread, "%.1f") + " | " +
+         with_iqr(row.process_cpu_ms, row.process_cpu_spread, "%.1f") + " | " +
+         format("%.6f", row.average_se) + " | " + format("%.4g", row.image_rmse) + " (" +
          format("%.2f%%", 100.0 * row.image_rmse_relative) + ") | " +
          std::to_string(row.vs_invocations) + " | " + std::to_string(row.primitives) + " | " +
          format("%.3f", row.vs_per_referenced_vertex) + " |\n";
@@ -95,7 +96,7 @@ std::string markdown_fits(const OverdrawReport& r) {
   if (r.gl_fit.points == 0) return "";
   return "\nAcross all " + std::to_string(r.gl_fit.points) +
          " rows (least squares on the medians): " + describe_fit("GL ms", r.gl_fit) + "; " +
-         describe_fit("FPS", r.fps_fit) + ".\n";
+         describe_fit("FPS", r.fps_fit) + "; " + describe_fit("CPU ms", r.process_cpu_fit) + ".\n";
 }
 
 // Per budget and K, one table in the thesis's column order.
@@ -118,8 +119,11 @@ std::string markdown_tables(const OverdrawReport& r) {
              std::to_string(first->passes) + " passes)\n\n";
       out +=
           "| method | strategy | clustering time | average overdraw | FPS (IQR) | GL ms (IQR) | "
-          "Average SE | image RMSE (rel.) | VS invocations | primitives | VS per vertex |\n";
-      out += "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+          "CPU ms (IQR) | Average SE | image RMSE (rel.) | VS invocations | primitives | VS per "
+          "vertex "
+          "|\n";
+      out +=
+          "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
       for (const OverdrawRow& row : r.rows)
         if (row.budget == budget && std::to_string(row.clusters) == k) out += table_row(row);
     }
@@ -185,19 +189,22 @@ std::string markdown(const OverdrawReport& r) {
 }
 
 void fit_timings(OverdrawReport& r) {
-  std::vector<double> overdraw, gl, fps;
+  std::vector<double> overdraw, gl, fps, cpu;
   for (const OverdrawRow& row : r.rows) {
     overdraw.push_back(row.average_overdraw);
     gl.push_back(row.gl_ms);
     fps.push_back(row.fps);
+    cpu.push_back(row.process_cpu_ms);
   }
   r.gl_fit = fit_line(overdraw, gl);
   r.fps_fit = fit_line(overdraw, fps);
+  r.process_cpu_fit = fit_line(overdraw, cpu);
 }
 
 std::string fit_csv(const OverdrawReport& r) {
   std::string out = "quantity,slope,intercept,r2,points\n";
-  for (const auto& [name, f] : {std::pair{"gl_ms", r.gl_fit}, std::pair{"fps", r.fps_fit}})
+  for (const auto& [name, f] : {std::pair{"gl_ms", r.gl_fit}, std::pair{"fps", r.fps_fit},
+                                std::pair{"process_cpu_ms", r.process_cpu_fit}})
     out += std::string(name) + "," + format("%.9g", f.slope) + "," + format("%.9g", f.intercept) +
            "," + format("%.9g", f.r2) + "," + std::to_string(f.points) + "\n";
   return out;
@@ -209,7 +216,7 @@ std::string csv(const OverdrawReport& r) {
       "clustering_seconds,grouping_seconds,average_overdraw,triangles_drawn,triangles,fps,"
       "frame_ms,cpu_ms,gl_ms,average_se,relative_error,image_rmse,image_rmse_relative,"
       "multi_cluster_triangles,vs_invocations,primitives,vs_per_referenced_vertex,fps_q1,fps_q3,"
-      "gl_ms_q1,gl_ms_q3\n";
+      "gl_ms_q1,gl_ms_q3,process_cpu_ms,process_cpu_ms_q1,process_cpu_ms_q3\n";
   for (const OverdrawRow& x : r.rows) {
     out += std::to_string(x.clusters) + "," + csv_field(x.method) + "," + csv_field(x.budget) +
            "," + std::to_string(x.register_budget) + "," + std::to_string(x.clusters_per_pass) +
@@ -224,7 +231,9 @@ std::string csv(const OverdrawReport& r) {
            "," + std::to_string(x.vs_invocations) + "," + std::to_string(x.primitives) + "," +
            format("%.6f", x.vs_per_referenced_vertex) + "," + format("%.4f", x.fps_spread.q1) +
            "," + format("%.4f", x.fps_spread.q3) + "," + format("%.4f", x.gl_ms_spread.q1) + "," +
-           format("%.4f", x.gl_ms_spread.q3) + "\n";
+           format("%.4f", x.gl_ms_spread.q3) + "," + format("%.4f", x.process_cpu_ms) + "," +
+           format("%.4f", x.process_cpu_spread.q1) + "," + format("%.4f", x.process_cpu_spread.q3) +
+           "\n";
   }
   return out;
 }
@@ -232,7 +241,8 @@ std::string csv(const OverdrawReport& r) {
 namespace {
 Json fit_json(const OverdrawReport& r) {
   Json fits = Json::object();
-  for (const auto& [name, f] : {std::pair{"gl_ms", r.gl_fit}, std::pair{"fps", r.fps_fit}})
+  for (const auto& [name, f] : {std::pair{"gl_ms", r.gl_fit}, std::pair{"fps", r.fps_fit},
+                                std::pair{"process_cpu_ms", r.process_cpu_fit}})
     fits[name] = {
         {"slope", f.slope}, {"intercept", f.intercept}, {"r2", f.r2}, {"points", f.points}};
   return fits;
@@ -268,7 +278,10 @@ std::string json(const OverdrawReport& r) {
                     {"fps_q1", x.fps_spread.q1},
                     {"fps_q3", x.fps_spread.q3},
                     {"gl_ms_q1", x.gl_ms_spread.q1},
-                    {"gl_ms_q3", x.gl_ms_spread.q3}});
+                    {"gl_ms_q3", x.gl_ms_spread.q3},
+                    {"process_cpu_ms", x.process_cpu_ms},
+                    {"process_cpu_ms_q1", x.process_cpu_spread.q1},
+                    {"process_cpu_ms_q3", x.process_cpu_spread.q3}});
   Json modes = Json::array();
   for (const ModeTiming& m : r.modes)
     modes.push_back({{"clusters", m.clusters},

@@ -30,6 +30,11 @@ struct OverdrawRow {
   // frame is 1000 / frame ms, so its quartiles are the frame time's, inverted).
   double fps = 0, frame_ms = 0, cpu_ms = 0, gl_ms = 0;
   Spread fps_spread, gl_ms_spread;
+  // The process's CPU time per frame, all threads (llvmpipe rasterises on its own threads):
+  // the work a frame costs, which time slices lost to other processes on a shared machine do
+  // not inflate the way they inflate wall-clock GL ms.
+  double process_cpu_ms = 0;
+  Spread process_cpu_spread;
   double average_se = 0, relative_error = 0;
   double image_rmse = 0, image_rmse_relative = 0;  // against the uncompressed render
   double multi_cluster_triangles = 0;              // share of triangles spanning clusters
@@ -60,17 +65,17 @@ struct OverdrawReport {
   std::vector<OverdrawRow> rows;
   std::vector<ModeTiming> modes;
   // GL ms and FPS against average overdraw, least squares over every row of the run.
-  LineFit gl_fit, fps_fit;
+  LineFit gl_fit, fps_fit, process_cpu_fit;
 };
 
-// Fills gl_fit and fps_fit from the rows.
+// Fills gl_fit, fps_fit and process_cpu_fit from the rows.
 void fit_timings(OverdrawReport& report);
 
 // Per budget and K, one table in the thesis's column order; then per K the FPS of multipass
 // (best strategy of the original method) against single-pass and decoupled.
 std::string markdown(const OverdrawReport& report);
 std::string csv(const OverdrawReport& report);
-// The two fits as CSV: quantity (gl_ms, fps), slope, intercept, r2, points.
+// The fits as CSV: quantity (gl_ms, fps, process_cpu_ms), slope, intercept, r2, points.
 std::string fit_csv(const OverdrawReport& report);
 std::string json(const OverdrawReport& report);
 

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <deque>
 #include <filesystem>
 #include <memory>
@@ -268,8 +269,14 @@ struct TimedRow {
   cpca::SuperClusters groups;
   int budget = 0, per_pass = 0;
   std::size_t row = 0;  // index into OverdrawReport::rows
-  std::vector<double> frame_ms, cpu_ms, gl_ms;
+  std::vector<double> frame_ms, cpu_ms, gl_ms, process_cpu_ms;
 };
+
+double process_cpu_ms_now() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
 
 // One table row without its timing: a compression grouped by one strategy under one budget,
 // rendered multipass once for the GL counts, the work counters and the image.
@@ -322,9 +329,12 @@ void time_turn(const Scene& s, TimedRow& t) {
   const auto r = multipass_renderer(s, *t.compression, t.budget, t.per_pass, t.groups);
   for (int f = 0; f < s.plan.warmup + s.plan.frames; ++f) {
     const double radians = s.plan.degrees_per_frame * f * std::numbers::pi / 180.0;
+    const double cpu0 = process_cpu_ms_now();
     const render::FrameTiming timing =
         r->render(s.camera, s.lighting, prt::axis_angle(s.axis, radians));
+    const double cpu = process_cpu_ms_now() - cpu0;
     if (f < s.plan.warmup) continue;
+    t.process_cpu_ms.push_back(cpu);
     t.frame_ms.push_back(timing.total_ms);
     t.cpu_ms.push_back(timing.cpu_ms);
     t.gl_ms.push_back(timing.gl_ms);
@@ -349,6 +359,8 @@ void time_rows(const Scene& s, std::vector<TimedRow>& timed, OverdrawReport& rep
     row.cpu_ms = spread(t.cpu_ms).median;
     row.gl_ms_spread = spread(t.gl_ms);
     row.gl_ms = row.gl_ms_spread.median;
+    row.process_cpu_spread = spread(t.process_cpu_ms);
+    row.process_cpu_ms = row.process_cpu_spread.median;
   }
   report.rounds = s.plan.rounds;
   fit_timings(report);
@@ -382,7 +394,12 @@ void measure_compression(const Scene& s, const Compression& c, OverdrawReport& r
       progress.show(c.label() + ": " + budget_name + " budget, " + strategy);
       cpca::SuperClusters groups;
       report.rows.push_back(measure_row(s, c, budget_name, budget, per_pass, strategy, &groups));
-      timed.push_back({&c, groups, budget, per_pass, report.rows.size() - 1, {}, {}, {}});
+      TimedRow& t = timed.emplace_back();
+      t.compression = &c;
+      t.groups = groups;
+      t.budget = budget;
+      t.per_pass = per_pass;
+      t.row = report.rows.size() - 1;
       ++progress.step;
       const double od = report.rows.back().average_overdraw;
       if (pictures && budget_name == picture_budget && od < best_overdraw) {
