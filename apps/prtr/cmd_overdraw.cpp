@@ -94,7 +94,7 @@ void add_flags(CLI::App* cmd, Options& o) {
                   "default: the GL context's register budget; thesis: 3 clusters per pass; or a "
                   "number of vec4 registers")
       ->capture_default_str();
-  cmd->add_option("--frames", o.frames, "Timed frames per configuration (FPS = median)")
+  cmd->add_option("--frames", o.frames, "Timed frames per row in every round")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--rounds", o.rounds,

@@ -124,8 +124,16 @@ std::string markdown_tables(const OverdrawReport& r) {
           "|\n";
       out +=
           "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+      OverdrawReport table;  // this table's rows, for their own fits
       for (const OverdrawRow& row : r.rows)
-        if (row.budget == budget && std::to_string(row.clusters) == k) out += table_row(row);
+        if (row.budget == budget && std::to_string(row.clusters) == k) {
+          out += table_row(row);
+          table.rows.push_back(row);
+        }
+      fit_timings(table);
+      if (table.rows.size() > 2)
+        out += "\nThis table's rows: " + describe_fit("CPU ms", table.process_cpu_fit) + "; " +
+               describe_fit("GL ms", table.gl_fit) + ".\n";
     }
   }
   return out;
