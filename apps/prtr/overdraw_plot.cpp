@@ -162,8 +162,8 @@ void timing_panel(Picture& p, int index, const OverdrawReport& report, Timing wh
                      : which == Timing::kFps ? "FPS"
                                              : "process CPU ms";
   draw_frame(p, a,
-             std::string(name) + " = " + number(f.slope) + " x + " + number(f.intercept) +
-                 ", R^2 = " + number(f.r2),
+             std::string(name) + " = " + number(f.slope) + " x " + (f.intercept < 0 ? "- " : "+ ") +
+                 number(std::abs(f.intercept)) + ", R^2 = " + number(f.r2),
              "average overdraw");
   draw_line(p, a.px(a.x.lo), a.py(f.at(a.x.lo)), a.px(a.x.hi), a.py(f.at(a.x.hi)), kGrey, area(a));
   for (const OverdrawRow& r : report.rows) {
