@@ -16,7 +16,8 @@
 # BUDGETS (thesis), CACHE (out/cache), RUNS (bunny-phong bunny-cook-torrance cat-phong: a
 # subset re-runs only those). Bakes and compressions are cached, so a second run only
 # re-times. Writes OUT_DIR/<run>.md (the tables), OUT_DIR/<run>/ (CSV, JSON, plots, pictures)
-# and OUT_DIR/summary.md (the tables of every run present).
+# and OUT_DIR/summary.md (scripts/overdraw_summary.py's condensed tables, then the full tables
+# of every run present).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 prtr=./build/prtr
@@ -30,9 +31,10 @@ done
 mkdir -p "$out" out/meshes
 [[ -f $cat_mesh ]] || $prtr mesh /usr/share/glmark2/models/cat.3ds --subdivide 1 -o "$cat_mesh" >&2
 
+BUDGETS=${BUDGETS:-thesis}
 common=(--probe "$probe" --cache "${CACHE:-out/cache}" --clusters 64,128,192,256 --pcs 8
         --alpha 0.05 --rows "${ROWS:-original,overdraw-reduction,coherence,both}"
-        --strategies "${STRATEGIES:-order,greedy,ils}" --budgets "${BUDGETS:-thesis}"
+        --strategies "${STRATEGIES:-order,greedy,ils}" --budgets "$BUDGETS"
         --rounds "${ROUNDS:-3}" --frames "${FRAMES:-3}" --warmup "${WARMUP:-1}"
         --width "${WIDTH:-1280}" --height "${HEIGHT:-948}")
 all=(bunny-phong bunny-cook-torrance cat-phong)
@@ -51,6 +53,13 @@ run cat-phong "$cat_mesh" --material phong
 summary=$out/summary.md
 {
   echo "# Overdraw experiments (written $(date -u +%Y-%m-%dT%H:%MZ))"
+  echo
+  echo "Per K and method, the lowest-overdraw strategy (scripts/overdraw_summary.py):"
+  echo
+  present=()
+  for name in "${all[@]}"; do [[ -f $out/$name/overdraw.json ]] && present+=("$out/$name"); done
+  python3 scripts/overdraw_summary.py "${present[@]}" --budget "${BUDGETS%%,*}"
+  echo "# Full tables"
   for name in "${all[@]}"; do
     [[ -f $out/$name.md ]] && { echo; echo "## $name"; echo; cat "$out/$name.md"; }
   done
