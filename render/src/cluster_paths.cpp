@@ -303,6 +303,15 @@ class MultipassPath : public ClusterPath {
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
+    if (feedback_ && queries.empty() && !work_ && !pass_ranges_.empty()) {
+      // Pass-through needs no per-pass state and the passes' index lists follow each other,
+      // so one draw blends the same triangles in the same order as one draw per pass.
+      IndexRange all = pass_ranges_.front();
+      all.count = GLsizei(pass_ranges_.back().first + pass_ranges_.back().count - all.first);
+      mesh_->draw(all);
+      glDisable(GL_BLEND);
+      return;
+    }
     for (std::size_t p = 0; p < pass_ranges_.size(); ++p) {
       if (pass_ranges_[p].count == 0) continue;
       if (!feedback_) bind_pass(p);
