@@ -6,9 +6,11 @@
 // overdraw for multipass at the context's register budget, multipass at 3 clusters per pass
 // (the thesis's 256-register GPU), decoupled, single-pass, uncompressed (with --transfer) and
 // CPU-shaded; plus the bare trivial-shader floor on the same mesh and each mode's frame time
-// as a ratio to it. Plain main() rather than Google Benchmark: each row is a median over
-// frames with glFinish, and lighting rotates every frame so constants are recomputed inside
-// the timing.
+// as a ratio to it; multipass both with feedback shading (the default) and in-draw shading,
+// process CPU per frame over all threads beside the wall clock (the load of a shared
+// machine inflates the wall clock far more), and the speed targets as ratios in the run. Plain
+// main() rather than Google Benchmark: each row is a median over frames with glFinish, and lighting
+// rotates every frame so constants are recomputed inside the timing.
 #include "cpca/compressed_file.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
@@ -23,10 +25,53 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+namespace {
+
+double process_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+}
+
+struct Sample {
+  double overdraw = 0, frame_ms = 0, cpu_ms = 0;  // cpu: process CPU over all threads
+};
+
+// The speed targets as ratios within this run, by wall clock and by process CPU (the load of
+// a shared machine inflates the first far more): the multipass cost of one unit of average
+// overdraw (two groupings of the same 3-cluster passes differ only in overdraw) against the
+// floor, and the thesis configuration's FPS.
+void print_targets(const std::vector<Sample>& multipass_3, const Sample& thesis,
+                   const Sample& floor, double floor_bg_ms) {
+  std::printf("\ntargets (this run; wall clock, then process CPU):\n");
+  if (multipass_3.size() == 2 && multipass_3[0].overdraw != multipass_3[1].overdraw) {
+    const Sample& a = multipass_3[0];
+    const Sample& b = multipass_3[1];
+    const double d = a.overdraw - b.overdraw;
+    const double wall = (a.frame_ms - b.frame_ms) / d, cpu = (a.cpu_ms - b.cpu_ms) / d;
+    std::printf(
+        "  multipass per unit overdraw (3/pass, order vs ILS): %.2f ms = %.2f x floor; "
+        "CPU %.2f ms = %.2f x floor\n",
+        wall, wall / floor.frame_ms, cpu, cpu / floor.cpu_ms);
+    std::printf("  multipass ILS frame / overdraw: %.2f ms = %.2f x floor; CPU %.2f x floor\n",
+                b.frame_ms / b.overdraw, b.frame_ms / b.overdraw / floor.frame_ms,
+                b.cpu_ms / b.overdraw / floor.cpu_ms);
+  }
+  if (thesis.frame_ms > 0)
+    std::printf(
+        "  thesis config (3/pass, ILS): %.2f FPS (floor %.2f, floor + background %.2f FPS); "
+        "CPU %.2f ms/frame = %.2f x floor\n",
+        1000.0 / thesis.frame_ms, 1000.0 / floor.frame_ms, 1000.0 / floor_bg_ms, thesis.cpu_ms,
+        thesis.cpu_ms / floor.cpu_ms);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
@@ -81,9 +126,21 @@ int main(int argc, char** argv) {
     const double floor_bg =
         render::floor_frame_ms(mesh, camera, {true, true, frames, 3, &probe, &floor_bg_work});
     const double floor_plain = render::floor_frame_ms(mesh, camera, {false, false, frames, 3});
-    std::printf("%-28s %6s %8s %7s %8s %7s %7s %6s %6s %9s %9s %6s %10s\n", "configuration",
+    // The floors' process CPU per frame: a run of 5F frames less a run of F, so the
+    // harness's setup (index order, compile, probe upload) and any first-frame cost cancel.
+    auto floor_cpu_ms = [&](const probes::Probe* bg) {
+      auto run_cpu = [&](int n) {
+        const double c0 = process_cpu_ms();
+        render::floor_frame_ms(mesh, camera, {true, true, n, 1, bg});
+        return process_cpu_ms() - c0;
+      };
+      const double few = run_cpu(frames);
+      return (run_cpu(5 * frames) - few) / (4 * frames);
+    };
+    const double floor_cpu = floor_cpu_ms(nullptr), floor_bg_cpu = floor_cpu_ms(&probe);
+    std::printf("%-28s %6s %8s %7s %8s %7s %7s %6s %6s %8s %9s %9s %6s %10s\n", "configuration",
                 "passes", "overdraw", "FPS", "frame ms", "cpu ms", "gl ms", "/floor", "/fl+bg",
-                "VS inv", "ref verts", "VS/ref", "FS inv");
+                "proc cpu", "VS inv", "ref verts", "VS/ref", "FS inv");
     auto print_work = [](const std::vector<render::PassWork>& work) {
       const render::WorkTotals w = render::work_totals(work);
       std::printf(" %9llu %9llu %6.3f %10llu\n", (unsigned long long)w.vs_invocations,
@@ -94,11 +151,12 @@ int main(int argc, char** argv) {
       std::erase_if(work, [](const render::PassWork& p) { return p.label == "background"; });
       return work;
     };
-    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f", "floor (trivial, cull+order)", 1,
-                1.0, 1000.0 / floor_ms, floor_ms, "-", "-", 1.0, floor_ms / floor_bg);
+    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f %8.2f",
+                "floor (trivial, cull+order)", 1, 1.0, 1000.0 / floor_ms, floor_ms, "-", "-", 1.0,
+                floor_ms / floor_bg, floor_cpu);
     print_work(floor_work);
-    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f", "floor + background", 1, 1.0,
-                1000.0 / floor_bg, floor_bg, "-", "-", floor_bg / floor_ms, 1.0);
+    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f %8.2f", "floor + background", 1,
+                1.0, 1000.0 / floor_bg, floor_bg, "-", "-", floor_bg / floor_ms, 1.0, floor_bg_cpu);
     print_work(floor_bg_work);
     std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f\n", "floor (trivial, plain)", 1,
                 1.0, 1000.0 / floor_plain, floor_plain, "-", "-", floor_plain / floor_ms,
@@ -118,17 +176,20 @@ int main(int argc, char** argv) {
                         {"uncompressed", render::Mode::kUncompressed, 0},
                         {"cpu-shaded", render::Mode::kCpu, 0}};
     std::vector<std::pair<std::string, std::vector<render::PassWork>>> details;
-    // Each path twice: with the earlier vertex numbering (", old #") and with first-use
-    // numbering, so the effect of renumbering is a ratio within this run.
+    std::vector<Sample> multipass_3;  // 3 clusters per pass: order, then ILS
+    Sample thesis, floor{1.0, floor_ms, floor_cpu};
+    // Multipass twice: shading by feedback (the default) and in the triangle draws
+    // (", in-draw"), so the effect is a ratio within this run.
     for (const Row& row : rows)
-      for (bool renumber : {false, true}) {
+      for (bool feedback : {false, true}) {
+        if (!feedback && row.mode != render::Mode::kMultipass) continue;
         if (row.mode == render::Mode::kUncompressed && !transfer) {
-          if (renumber) std::printf("%-28s (skipped: pass --transfer)\n", row.name);
+          std::printf("%-28s (skipped: pass --transfer)\n", row.name);
           continue;
         }
-        const std::string name = std::string(row.name) + (renumber ? "" : ", old #");
+        const std::string name = std::string(row.name) + (feedback ? "" : ", in-draw");
         render::RendererOptions o;
-        o.renumber_vertices = renumber;
+        o.multipass_feedback = feedback;
         o.mode = row.mode;
         o.clusters_per_pass = row.clusters_per_pass;
         if (row.strategy) {
@@ -137,19 +198,29 @@ int main(int argc, char** argv) {
               row.strategy, {set.cluster_of, tris, set.cluster_count, row.clusters_per_pass});
         }
         render::Renderer r(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
+        // Process CPU time over every thread (llvmpipe's included) per frame: the work, which
+        // a shared machine's load inflates far less than the wall clock.
+        r.render(camera, lighting, Eigen::Matrix3d::Identity());  // compiles outside the count
+        const double cpu0 = process_cpu_ms();
         const render::TimingSummary t =
             render::measure(r, camera, lighting, Eigen::Matrix3d::Identity(),
                             Eigen::Vector3d::UnitY(), 1.0, frames, 3);
+        const double proc_ms = (process_cpu_ms() - cpu0) / (frames + 3);
         r.set_count_work(true);
         r.render(camera, lighting, Eigen::Matrix3d::Identity());
-        std::printf("%-28s %6d %8.3f %7.2f %8.2f %7.2f %7.2f %6.2f %6.2f", name.c_str(),
+        std::printf("%-28s %6d %8.3f %7.2f %8.2f %7.2f %7.2f %6.2f %6.2f %8.2f", name.c_str(),
                     r.stats().passes, r.stats().average_overdraw, t.fps, t.frame_ms_median,
                     t.cpu_ms_median, t.gl_ms_median, t.frame_ms_median / floor_ms,
-                    t.frame_ms_median / floor_bg);
+                    t.frame_ms_median / floor_bg, proc_ms);
         print_work(mesh_only(r.stats().pass_work));
         details.emplace_back(name, r.stats().pass_work);
+        if (feedback && row.mode == render::Mode::kMultipass && row.clusters_per_pass == 3)
+          multipass_3.push_back({r.stats().average_overdraw, t.frame_ms_median, proc_ms});
+        if (feedback && row.strategy)
+          thesis = {r.stats().average_overdraw, t.frame_ms_median, proc_ms};
         std::fflush(stdout);
       }
+    print_targets(multipass_3, thesis, floor, floor_bg);
     // Per draw, so a path's waste can be traced to the draw that has it; multipass shading
     // passes as one line (their sum, and the worst pass).
     std::printf("\nper draw: VS invocations / referenced vertices (primitives, FS invocations)\n");

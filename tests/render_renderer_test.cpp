@@ -196,12 +196,17 @@ TEST_P(CaptureTest, EveryModeMatchesTheCpuReference) {
   const auto reference = render::reference_vertex_radiance(s.set, s.mesh, lit, s.camera.eye);
   const int registers = render::constant_layout(s.set).registers_per_cluster();
   for (render::Mode mode : {render::Mode::kMultipass, render::Mode::kSinglepass,
-                            render::Mode::kDecoupled, render::Mode::kCpu}) {
-    // Three clusters per pass: several passes, so the sum over passes is exercised.
-    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, options(mode, 3 * registers));
-    const auto captured = r.capture_vertex_radiance(s.camera, s.lighting, R);
-    EXPECT_LT(max_relative_error(captured, reference), kVertexTolerance) << render::mode_name(mode);
-  }
+                            render::Mode::kDecoupled, render::Mode::kCpu})
+    for (bool feedback : {true, false}) {
+      if (!feedback && mode != render::Mode::kMultipass) continue;
+      // Three clusters per pass: several passes, so the sum over passes is exercised.
+      render::RendererOptions o = options(mode, 3 * registers);
+      o.multipass_feedback = feedback;
+      render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
+      const auto captured = r.capture_vertex_radiance(s.camera, s.lighting, R);
+      EXPECT_LT(max_relative_error(captured, reference), kVertexTolerance)
+          << render::mode_name(mode) << (feedback ? "" : ", in-draw shading");
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Orders, CaptureTest,
@@ -310,14 +315,17 @@ TEST(Renderer, MultipassEqualsSinglepassForOneTwoAndManyPasses) {
   const render::Image single = render_once(ctx, s, options(render::Mode::kSinglepass), s.camera, R);
   const double scale = single.max_rgb();
   ASSERT_GT(scale, 0.0);
-  for (int per_pass : {K, (K + 1) / 2, 1}) {
-    render::RenderStats stats;
-    const render::Image multi = render_once(
-        ctx, s, options(render::Mode::kMultipass, per_pass * registers), s.camera, R, &stats);
-    EXPECT_EQ(stats.passes, (K + per_pass - 1) / per_pass);
-    EXPECT_LT(max_abs_difference(multi, single), image_tolerance(4, 4) * scale)
-        << per_pass << " clusters per pass";
-  }
+  // Both ways of shading a pass: by feedback into the radiance buffer, and in the draw.
+  for (int per_pass : {K, (K + 1) / 2, 1})
+    for (bool feedback : {true, false}) {
+      render::RenderStats stats;
+      render::RendererOptions o = options(render::Mode::kMultipass, per_pass * registers);
+      o.multipass_feedback = feedback;
+      const render::Image multi = render_once(ctx, s, o, s.camera, R, &stats);
+      EXPECT_EQ(stats.passes, (K + per_pass - 1) / per_pass);
+      EXPECT_LT(max_abs_difference(multi, single), image_tolerance(4, 4) * scale)
+          << per_pass << " clusters per pass, feedback " << feedback;
+    }
   // Alpha is coverage: both 0 and 1 occur, nothing else.
   int covered = 0;
   for (int i = 0; i < single.width * single.height; ++i) {

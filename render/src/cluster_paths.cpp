@@ -107,9 +107,12 @@ class ClusterPath : public RenderPath {
   // in first-use order within a slot. `pass_blocks`: after the whole mesh, a block of copies
   // per pass of the vertices its triangles reference, each in the pass's own first-use order,
   // so every pass draws consecutive indices (pass_lists_).
+  // `zero_copies` (with `sort_by_slot`, instead of pass blocks): each pass's index list names
+  // its own corners by their mesh vertex and other passes' corners by one appended copy per
+  // vertex whose radiance stays zero (zero_copy_lists_).
   // `legacy_sort`: the slot sort this path had before renumbering (renumber_vertices off).
   ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot,
-              bool pass_blocks, bool legacy_sort)
+              bool pass_blocks, bool legacy_sort, bool zero_copies = false)
       : constants_(*in.set), layout_(constants_.layout()) {
     const int per_pass = clusters_per_pass(in, layout_.registers_per_cluster());
     plan_ = plan_slots(group(in, per_pass, split), in.set->cluster_count,
@@ -128,6 +131,7 @@ class ClusterPath : public RenderPath {
           pass_triangles_.push_back(ids);
       }
     }
+    if (zero_copies) zero_copy_lists_ = zero_copy_lists(in, optimize, order);
     mesh_ = std::make_unique<GpuMesh>(in.mesh, std::move(order), optimize);
     gpu_set_ = reordered_set(*in.set);
     pass_of_vertex_.assign(mesh_->vertex_count(), 0);
@@ -151,6 +155,7 @@ class ClusterPath : public RenderPath {
     whole_ = mesh_->add_all_triangles();
     for (const auto& list : pass_lists_) pass_ranges_.push_back(mesh_->add_indices(list));
     for (const auto& ids : pass_triangles_) pass_ranges_.push_back(mesh_->add_triangles(ids));
+    for (const auto& list : zero_copy_lists_) pass_ranges_.push_back(mesh_->add_indices(list));
     mesh_->uint_attribute(kAttrCluster, cluster_attribute);
     mesh_->uint_attribute(kAttrPass, pass_of_vertex_);
     const int N = gpu_set_.component_count;
@@ -177,13 +182,43 @@ class ClusterPath : public RenderPath {
   cpca::CompressedSet gpu_set_;  // in GPU vertex order; cluster_of holds slots, not ids
   std::vector<float> host_;
   std::vector<std::uint32_t> pass_of_vertex_;
-  std::vector<std::vector<std::uint32_t>> pass_lists_;      // GPU indices, one per pass
-  std::vector<std::vector<std::uint32_t>> pass_triangles_;  // without renumbering
+  std::vector<std::vector<std::uint32_t>> pass_lists_;       // GPU indices, one per pass
+  std::vector<std::vector<std::uint32_t>> pass_triangles_;   // without renumbering
+  std::vector<std::vector<std::uint32_t>> zero_copy_lists_;  // GPU indices, one per pass
   std::vector<IndexRange> pass_ranges_;
   GLuint constant_buffer_ = 0;
   GLenum constant_target_ = GL_UNIFORM_BUFFER;
 
  private:
+  // Per pass, its triangles' corners in GPU numbering: an own corner is its mesh vertex (GPU
+  // index = position in `order`, the first vertex_count entries), a foreign one the vertex's
+  // zero copy, appended to `order` on first need.
+  std::vector<std::vector<std::uint32_t>> zero_copy_lists(const PathInput& in, bool optimize,
+                                                          std::vector<std::uint32_t>& order) const {
+    const std::size_t V = in.mesh.vertex_count();
+    std::vector<std::uint32_t> gpu_of(V), zero_of(V, ~0u);
+    for (std::size_t i = 0; i < V; ++i) gpu_of[order[i]] = std::uint32_t(i);
+    std::vector<cpca::TriangleIndices> tris(in.mesh.triangles.begin(), in.mesh.triangles.end());
+    std::vector<std::vector<std::uint32_t>> lists;
+    for (const auto& ids : cpca::triangles_per_pass(in.set->cluster_of, tris, plan_.groups)) {
+      const std::uint32_t p = std::uint32_t(lists.size());
+      std::vector<std::uint32_t> list = triangle_corners(in.mesh, ids, optimize);
+      for (std::uint32_t& v : list) {
+        if (plan_.groups.pass_of[in.set->cluster_of[v]] == p) {
+          v = gpu_of[v];
+          continue;
+        }
+        if (zero_of[v] == ~0u) {
+          zero_of[v] = std::uint32_t(order.size());
+          order.push_back(v);
+        }
+        v = zero_of[v];
+      }
+      lists.push_back(std::move(list));
+    }
+    return lists;
+  }
+
   std::vector<std::uint32_t> vertex_order(const meshes::Mesh& mesh, const cpca::CompressedSet& set,
                                           bool sort, bool optimize, bool renumber) const {
     std::vector<std::uint32_t> rank(set.vertex_count);
@@ -219,10 +254,19 @@ class ClusterPath : public RenderPath {
 };
 
 // Depth pre-pass, then one additive pass per super-cluster with GL_EQUAL depth, each binding
-// its clusters' constants as one UBO range and drawing only its own triangles.
+// only its clusters' constants (one UBO range) and drawing only its own triangles. With
+// multipass_feedback, each pass's shading is split in two: its own vertices (one contiguous
+// range, as vertices are sorted by slot) shaded once as points into the radiance buffer, then
+// its triangles drawn pass-through, other passes' corners reading a zero copy. llvmpipe's
+// vertex stage masks a branch rather than skipping it, so in-draw shading paid the whole
+// reconstruction for every foreign corner, and a triangle draw's vertex stage cost ~2.6x a
+// points draw's per vertex (docs/ARCHITECTURE.md "Rendering").
 class MultipassPath : public ClusterPath {
  public:
-  explicit MultipassPath(const PathInput& in) : ClusterPath(in, true, false, false, true, true) {
+  explicit MultipassPath(const PathInput& in)
+      : ClusterPath(in, true, false, in.options.multipass_feedback, !in.options.multipass_feedback,
+                    true, in.options.multipass_feedback),
+        feedback_(in.options.multipass_feedback) {
     std::vector<cpca::TriangleIndices> tris(in.mesh.triangles.begin(), in.mesh.triangles.end());
     const cpca::OverdrawStats od = cpca::overdraw(in.set->cluster_of, tris, plan_.groups);
     in.stats.triangles_per_pass = od.triangles_per_pass;
@@ -235,31 +279,42 @@ class MultipassPath : public ClusterPath {
     upload(relative, GL_UNIFORM_BUFFER, true);
     depth_program_ =
         GlProgram("depth pre-pass", position_vertex_shader(), coverage_fragment_shader());
-    shade_program_ = GlProgram(
-        "multipass shading",
-        compressed_vertex_shader(layout_, ConstantAccess::kUniformSlot, plan_.slots_per_pass, true),
-        radiance_fragment_shader(), true);
+    shade_program_ = GlProgram("multipass shading",
+                               compressed_vertex_shader(layout_, ConstantAccess::kUniformSlot,
+                                                        plan_.slots_per_pass, !feedback_),
+                               radiance_fragment_shader(), true);
+    if (feedback_) prepare_feedback();
   }
 
   std::size_t passes() const override { return pass_ranges_.size(); }
   bool pass_drew(std::size_t p) const override { return pass_ranges_[p].count > 0; }
 
   void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
+    if (feedback_) shade_own_vertices(camera);
     set_camera_uniforms(depth_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);  // rgb = 0, alpha = coverage
     glDepthFunc(GL_LESS);
     begin_work("depth", whole_.referenced);
     mesh_->draw(whole_);
     end_work();
-    set_camera_uniforms(shade_program_, camera);
+    set_camera_uniforms(feedback_ ? passthrough_program_ : shade_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
     glDepthFunc(GL_EQUAL);
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
+    if (feedback_ && queries.empty() && !work_ && !pass_ranges_.empty()) {
+      // Pass-through needs no per-pass state and the passes' index lists follow each other,
+      // so one draw blends the same triangles in the same order as one draw per pass.
+      IndexRange all = pass_ranges_.front();
+      all.count = GLsizei(pass_ranges_.back().first + pass_ranges_.back().count - all.first);
+      mesh_->draw(all);
+      glDisable(GL_BLEND);
+      return;
+    }
     for (std::size_t p = 0; p < pass_ranges_.size(); ++p) {
       if (pass_ranges_[p].count == 0) continue;
-      bind_pass(p);
+      if (!feedback_) bind_pass(p);
       if (!queries.empty()) glBeginQuery(GL_PRIMITIVES_GENERATED, queries[p]);
       begin_work("shade " + std::to_string(p), pass_ranges_[p].referenced);
       mesh_->draw(pass_ranges_[p]);
@@ -269,8 +324,16 @@ class MultipassPath : public ClusterPath {
     glDisable(GL_BLEND);
   }
 
-  // Vertices outside a pass output zero, so the passes' captures sum to the radiance.
+  // In-draw shading: vertices outside a pass output zero, so the passes' captures sum to the
+  // radiance. Feedback: the radiance buffer's mesh vertices (not the zero copies).
   std::vector<Rgb> capture(const Camera& camera) override {
+    if (feedback_) {
+      shade_own_vertices(camera);
+      std::vector<Rgb> radiance;
+      mesh_->read(mesh_->radiance_buffer(), radiance, false);
+      radiance.resize(mesh_->source_vertex_count());
+      return radiance;
+    }
     set_camera_uniforms(shade_program_, camera);
     std::vector<Rgb> radiance(mesh_->vertex_count(), Rgb::Zero());
     for (std::size_t p = 0; p < plan_.pass_offset.size(); ++p) {
@@ -282,12 +345,53 @@ class MultipassPath : public ClusterPath {
 
  private:
   void bind_pass(std::size_t p) {
-    glUniform1ui(shade_program_.uniform("u_pass"), GLuint(p));
+    if (!feedback_) glUniform1ui(shade_program_.uniform("u_pass"), GLuint(p));
     glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, plan_.pass_offset[p],
                       GLsizeiptr(plan_.slots_per_pass) * cluster_bytes());
   }
 
-  GlProgram depth_program_, shade_program_;
+  // Each pass's own vertex range (mesh vertices are sorted by pass), and zeros in the radiance
+  // buffer, which feedback never writes past the mesh vertices: the zero copies' radiance.
+  void prepare_feedback() {
+    const std::size_t V = mesh_->source_vertex_count();
+    own_first_.assign(plan_.pass_offset.size() + 1, GLint(V));
+    for (std::size_t i = V; i-- > 0;) own_first_[pass_of_vertex_[i]] = GLint(i);
+    for (std::size_t p = plan_.pass_offset.size(); p-- > 0;)
+      own_first_[p] = std::min(own_first_[p], own_first_[p + 1]);
+    const std::vector<float> zeros(mesh_->vertex_count() * 3, 0.f);
+    glBindBuffer(GL_ARRAY_BUFFER, mesh_->radiance_buffer());
+    glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(zeros.size() * 4), zeros.data());
+    passthrough_program_ =
+        GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
+  }
+
+  // One feedback session: the passes' ranges follow each other from vertex 0, so the captured
+  // points land at their own vertices.
+  void shade_own_vertices(const Camera& camera) {
+    set_camera_uniforms(shade_program_, camera);
+    glEnable(GL_RASTERIZER_DISCARD);
+    // Attribute 15 reads the buffer feedback writes: off meanwhile (GL 4.5 core, 13.2.2).
+    mesh_->bind();
+    glDisableVertexAttribArray(kAttrRadiance);
+    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, mesh_->radiance_buffer());
+    glBeginTransformFeedback(GL_POINTS);
+    begin_work("feedback", mesh_->source_vertex_count());
+    for (std::size_t p = 0; p + 1 < own_first_.size(); ++p) {
+      const GLsizei count = own_first_[p + 1] - own_first_[p];
+      if (count == 0) continue;
+      bind_pass(p);
+      glDrawArrays(GL_POINTS, own_first_[p], count);
+    }
+    end_work();
+    glEndTransformFeedback();
+    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+    glEnableVertexAttribArray(kAttrRadiance);
+    glDisable(GL_RASTERIZER_DISCARD);
+  }
+
+  bool feedback_;
+  std::vector<GLint> own_first_;  // pass p's own vertices: [own_first_[p], own_first_[p + 1])
+  GlProgram depth_program_, shade_program_, passthrough_program_;
 };
 
 // All clusters' constants in one SSBO indexed by the vertex's slot; one draw.

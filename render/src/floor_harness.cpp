@@ -81,13 +81,15 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
   for (int f = -options.warmup; f < options.frames; ++f) {
     const bool count = options.work && f + 1 == options.frames;
     const auto start = std::chrono::steady_clock::now();
+    // Masks before the clear: the background pass leaves depth writes off, and glClear
+    // honours the masks (the mesh would then fail GL_LESS against last frame's depth).
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0.f, 0.f, 0.f, 0.f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     program.use();
     glBindVertexArray(vao);
     glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     if (options.cull_back_faces) glEnable(GL_CULL_FACE);
     if (count) counter.begin("mesh", referenced);
     glDrawElements(GL_TRIANGLES, GLsizei(indices.size()), GL_UNSIGNED_INT, nullptr);

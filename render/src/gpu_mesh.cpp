@@ -95,6 +95,12 @@ std::vector<std::uint32_t> first_use_rank(const meshes::Mesh& mesh, bool optimiz
   return rank;
 }
 
+std::vector<std::uint32_t> triangle_corners(const meshes::Mesh& source,
+                                            const std::vector<std::uint32_t>& triangle_ids,
+                                            bool optimize) {
+  return flatten(source, triangle_ids, optimize);
+}
+
 std::vector<std::uint32_t> append_vertex_block(const meshes::Mesh& source,
                                                const std::vector<std::uint32_t>& triangle_ids,
                                                bool optimize,

@@ -39,6 +39,12 @@ std::vector<std::uint32_t> append_vertex_block(const meshes::Mesh& source,
                                                bool optimize,
                                                std::vector<std::uint32_t>& old_of_new);
 
+// The corners of `triangle_ids`, three per triangle, in vertex-cache order when `optimize`
+// (source numbering).
+std::vector<std::uint32_t> triangle_corners(const meshes::Mesh& source,
+                                            const std::vector<std::uint32_t>& triangle_ids,
+                                            bool optimize);
+
 class GpuMesh {
  public:
   // `old_of_new[i]` is the source vertex stored at GPU vertex i. Its first

@@ -67,6 +67,11 @@ struct RendererOptions {
   // so llvmpipe shades each about once per draw; false keeps the earlier numbering (slot
   // order) to measure the difference.
   bool renumber_vertices = true;
+  // Multipass: each pass first shades its own vertices as points into the radiance buffer
+  // (transform feedback, only the pass's constants bound), then draws its triangles
+  // pass-through, the other passes' corners reading a zero copy. false shades in the
+  // triangle draws' vertex stage (own and foreign corners alike), to measure the difference.
+  bool multipass_feedback = true;
   bool count_primitives = false;  // GL_PRIMITIVES_GENERATED query per pass (slower)
   // Pipeline-statistics queries around every draw of a frame (RenderStats::pass_work).
   bool count_work = false;
