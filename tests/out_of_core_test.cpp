@@ -121,7 +121,9 @@ TEST(OutOfCore, LbgOverTinyBlocksEqualsTheWholeMatrixLbg) {
       const cpca::RowBlocks blocks(x, block, releases.hook());
       expect_same(cpca::lbg(blocks, o), oracle);
       EXPECT_LE(releases.largest_partial(x.rows()), std::max<Eigen::Index>(block, 256) + 255);
-      if (block < x.rows()) EXPECT_GT(releases.largest_partial(x.rows()), 0);
+      if (block < x.rows()) {
+        EXPECT_GT(releases.largest_partial(x.rows()), 0);
+      }
     }
   }
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -121,8 +122,12 @@ double clustering_energy(const Eigen::Ref<const DataMatrix>& x,
   return clustering_energy(RowBlocks(x), cluster_of, means);
 }
 
-int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
-                         std::vector<std::uint32_t>& cluster_of, int cluster_count) {
+namespace {
+
+// `after_gather` runs once the largest cluster's rows are copied, so an out-of-core source
+// can drop the pages the gather touched before the next split gathers again.
+int split_clusters(const Eigen::Ref<const DataMatrix>& x, std::vector<std::uint32_t>& cluster_of,
+                   int cluster_count, const std::function<void()>& after_gather) {
   if (Eigen::Index(cluster_count) > x.rows())
     throw std::invalid_argument("cannot form " + std::to_string(cluster_count) + " clusters from " +
                                 std::to_string(x.rows()) +
@@ -141,6 +146,7 @@ int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
     const Eigen::Index m = Eigen::Index(members.size());
     Eigen::MatrixXf centred(m, x.cols());
     for (Eigen::Index i = 0; i < m; ++i) centred.row(i) = x.row(members[std::size_t(i)]);
+    if (after_gather) after_gather();
     const Eigen::RowVectorXf mean = centred.colwise().mean();
     centred.rowwise() -= mean;
     // Principal direction by power iteration, started from the farthest point's offset
@@ -172,6 +178,18 @@ int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
   return splits;
 }
 
+}  // namespace
+
+int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
+                         std::vector<std::uint32_t>& cluster_of, int cluster_count) {
+  return split_clusters(x, cluster_of, cluster_count, {});
+}
+
+int split_empty_clusters(const RowBlocks& x, std::vector<std::uint32_t>& cluster_of,
+                         int cluster_count) {
+  return split_clusters(x.all(), cluster_of, cluster_count, [&x] { x.release_all(); });
+}
+
 LbgResult lbg(const RowBlocks& x, const LbgOptions& options, const GeometryCoherence* coherence,
               const LbgCallback& callback) {
   const int k = options.clusters;
@@ -194,8 +212,7 @@ LbgResult lbg(const RowBlocks& x, const LbgOptions& options, const GeometryCoher
     } else {
       r.cluster_of = nearest_means(x, norms, r.means);
     }
-    r.splits += split_empty_clusters(x.all(), r.cluster_of, k);
-    x.release_all();
+    r.splits += split_empty_clusters(x, r.cluster_of, k);
     r.means = cluster_means(x, r.cluster_of, k);
     const double energy = clustering_energy(x, r.cluster_of, r.means);
     r.energy.push_back(energy);

@@ -55,6 +55,9 @@ LbgResult lbg(const RowBlocks& x, const LbgOptions& options,
 // there are more clusters than points.
 int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
                          std::vector<std::uint32_t>& cluster_of, int cluster_count);
+// The same, releasing the source's pages after each split's gather of the largest cluster.
+int split_empty_clusters(const RowBlocks& x, std::vector<std::uint32_t>& cluster_of,
+                         int cluster_count);
 
 // Mean of each cluster's rows (K x D), accumulated in double. Empty clusters get zero rows.
 DataMatrix cluster_means(const Eigen::Ref<const DataMatrix>& x,
