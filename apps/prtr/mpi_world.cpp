@@ -1,7 +1,9 @@
 #include "mpi_world.h"
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <thread>
 
 #ifdef PRTR_HAVE_MPI
 #include <mpi.h>
@@ -38,7 +40,16 @@ bool mpi_built() {
 }
 
 void mpi_barrier() {
-  if (mpi_world().size > 1) MPI_Barrier(MPI_COMM_WORLD);
+  if (mpi_world().size == 1) return;
+  // Polled with sleeps: MPI_Barrier spins, and a rank that finished its shard early would
+  // take a core from the ranks still baking on the same node.
+  MPI_Request request{};
+  MPI_Ibarrier(MPI_COMM_WORLD, &request);
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
 }
 
 int mpi_min(int value) {
