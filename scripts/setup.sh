@@ -19,6 +19,7 @@ packages=(
   libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
   libassimp-dev  # glTF 2.0 (.gltf, .glb) and 3DS import, meshes/src/read_assimp.cpp
+  libopenmpi-dev openmpi-bin  # mpirun prtr bake (optional CMake component PRTR_MPI) and its test
   ffmpeg python3-matplotlib
   libcpp-httplib-dev    # prtr view: the HTTP server
   libturbojpeg0-dev     # prtr view: JPEG frames

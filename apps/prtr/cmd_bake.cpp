@@ -4,12 +4,15 @@
 #include "commands.h"
 #include "json_output.h"
 #include "meshes/load.h"
+#include "mpi_world.h"
 #include "pipeline.h"
 #include "progress_bar.h"
 #include "prt/transfer_file.h"
+#include "prt/transfer_shard.h"
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +52,42 @@ prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
           ? prt::bake_shard_to_file(mesh, options, output, shard.first, shard.second, block, stats)
           : prt::bake_to_file(mesh, options, output, block, stats);
   bar.finish();
+  return set;
+}
+
+// Under mpirun: rank r bakes shard r of R beside the output, and once every rank has
+// committed its shard rank 0 merges them into the output (atomically, prt::merge_shards)
+// and deletes them. A rank that fails aborts the whole job before the merge, so nothing
+// appears at the output; a rerun overwrites any shards left behind.
+prt::TransferSet mpi_bake(const meshes::Mesh& mesh, const prt::BakeOptions& options,
+                          const std::string& output, std::uint64_t block, bool quiet,
+                          prt::BakeStats* stats, MpiWorld world) {
+  if (options.bounces > 0)
+    throw UsageError(
+        "mpirun prtr bake needs --bounces 0: interreflection passes under MPI are not built "
+        "yet; bake bounces in one process (it streams, so memory stays bounded)");
+  std::vector<std::filesystem::path> shards;
+  for (int r = 0; r < world.size; ++r)
+    shards.emplace_back(output + ".rank" + std::to_string(r) + "of" + std::to_string(world.size) +
+                        ".prtshard");
+  prt::TransferSet set;
+  try {
+    set = stream_bake(mesh, options, shards[std::size_t(world.rank)].string(), block,
+                      {std::uint32_t(world.rank), std::uint32_t(world.size)},
+                      quiet || world.rank != 0, stats);
+  } catch (const std::exception& e) {
+    mpi_abort(std::string("bake of its shard failed: ") + e.what());
+  }
+  mpi_barrier();
+  if (world.rank == 0) {
+    try {
+      prt::merge_shards(shards, output);
+      for (const auto& shard : shards) std::filesystem::remove(shard);
+    } catch (const std::exception& e) {
+      mpi_abort(std::string("merge failed: ") + e.what());
+    }
+  }
+  mpi_barrier();
   return set;
 }
 
@@ -139,8 +178,15 @@ Runner add_bake_command(CLI::App& app) {
     prt::BakeOptions options = resolve_bake_flags(o.flags);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     prt::BakeStats stats;
-    const prt::TransferSet set = stream_bake(mesh, options, o.output, o.block, parse_shard(o.shard),
-                                             o.quiet || o.json, &stats);
+    const MpiWorld world = mpi_world();
+    if (world.size > 1 && !o.shard.empty())
+      throw UsageError("--shard and mpirun both split the vertices: use one of them");
+    const prt::TransferSet set =
+        world.size > 1
+            ? mpi_bake(mesh, options, o.output, o.block, o.quiet || o.json, &stats, world)
+            : stream_bake(mesh, options, o.output, o.block, parse_shard(o.shard), o.quiet || o.json,
+                          &stats);
+    if (world.rank != 0) return;
 
     if (o.json) {
       std::printf("%s\n", dump_json(summary_json(mesh, stats)).c_str());

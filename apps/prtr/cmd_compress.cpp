@@ -9,8 +9,10 @@
 #include "meshes/load.h"
 #include "pipeline.h"
 #include "progress_bar.h"
+#include "prt/mapped_transfer.h"
 #include "prt/transfer_file.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -22,7 +24,17 @@ struct Options {
   std::string transfer, mesh, output;
   CompressFlags compress;
   bool quiet = false, json = false;
+  std::uint64_t block_vertices = 0;  // 0: as many as fit kDefaultBlockBytes
 };
+
+// Out of core: the .prtx is mapped, and every pass over it holds one block of rows.
+constexpr std::uint64_t kDefaultBlockBytes = std::uint64_t(64) << 20;
+
+Eigen::Index block_rows(const prt::TransferSet& header, std::uint64_t flag) {
+  if (flag > 0) return Eigen::Index(flag);
+  const std::uint64_t row = std::max<std::uint64_t>(1, header.floats_per_vertex() * 4);
+  return Eigen::Index(std::max<std::uint64_t>(1, kDefaultBlockBytes / row));
+}
 
 // What the report prints besides the set and the compression's own report.
 struct Sizes {
@@ -119,18 +131,30 @@ Runner add_compress_command(CLI::App& app) {
   add_compress_flags(cmd, opt->compress, CompressFlagSet::kCompress);
   cmd->add_flag("--json", opt->json, "Print the report as one JSON line instead");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress bar");
+  cmd->add_option("--block-vertices", opt->block_vertices,
+                  "Vertices per block of the out-of-core passes (0: 64 MiB of rows; rounded "
+                  "up to a multiple of 256); the result does not depend on it")
+      ->capture_default_str();
 
   return [opt] {
     const Options& o = *opt;
     const cpca::CompressOptions options = resolve_compress_flags(o.compress);
     check_sizes(options, o);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
-    const prt::TransferSet transfer = prt::read_transfer(o.transfer);
+    const prt::MappedTransfer mapped(o.transfer);
+    const prt::TransferSet& transfer = mapped.header();
+    const Eigen::Map<const cpca::DataMatrix> rows(mapped.payload(),
+                                                  Eigen::Index(transfer.vertex_count),
+                                                  Eigen::Index(transfer.floats_per_vertex()));
+    const cpca::RowBlocks blocks(rows, block_rows(transfer, o.block_vertices),
+                                 [&mapped](Eigen::Index first, Eigen::Index count) {
+                                   mapped.release(std::uint64_t(first), std::uint64_t(count));
+                                 });
     cpca::CompressReport report;
     const cpca::CompressedSet set =
-        run_compress(transfer, mesh, o.mesh, options, o.quiet || o.json, &report);
+        run_compress(transfer, blocks, mesh, o.mesh, options, o.quiet || o.json, &report);
     cpca::write_compressed(o.output, set);
-    const Sizes sizes{double(transfer.data.size()) * 4.0,
+    const Sizes sizes{double(transfer.vertex_count) * double(transfer.floats_per_vertex()) * 4.0,
                       double(std::filesystem::file_size(o.output)), double(mesh.triangle_count())};
     if (o.json)
       print_json(set, report, sizes);

@@ -55,6 +55,16 @@ prt::TransferSet run_bake(const meshes::Mesh& mesh, const std::string& mesh_name
 cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes::Mesh& mesh,
                                  const std::string& mesh_path, cpca::CompressOptions options,
                                  bool quiet, cpca::CompressReport* report) {
+  const Eigen::Map<const cpca::DataMatrix> data(transfer.data.data(),
+                                                Eigen::Index(transfer.vertex_count),
+                                                Eigen::Index(transfer.floats_per_vertex()));
+  return run_compress(transfer, cpca::RowBlocks(data), mesh, mesh_path, options, quiet, report);
+}
+
+cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const cpca::RowBlocks& data,
+                                 const meshes::Mesh& mesh, const std::string& mesh_path,
+                                 cpca::CompressOptions options, bool quiet,
+                                 cpca::CompressReport* report) {
   if (meshes::content_hash(mesh) != transfer.mesh_hash ||
       mesh.vertex_count() != transfer.vertex_count)
     throw std::runtime_error("the transfer was not baked from " + mesh_path +
@@ -64,9 +74,6 @@ cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes:
     throw std::runtime_error(mesh_path + ": path longer than " +
                              std::to_string(cpca::kMaxMeshPathBytes) +
                              " bytes; move the mesh to a shorter path");
-  const Eigen::Map<const cpca::DataMatrix> data(transfer.data.data(),
-                                                Eigen::Index(transfer.vertex_count),
-                                                Eigen::Index(transfer.floats_per_vertex()));
   options.layout = {transfer.order, transfer.channels, transfer.columns()};
   const cpca::Geometry geometry = geometry_of(mesh);
   ProgressBar bar(quiet);

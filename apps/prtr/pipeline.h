@@ -37,6 +37,12 @@ prt::TransferSet run_bake(const meshes::Mesh& mesh, const std::string& mesh_name
 cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes::Mesh& mesh,
                                  const std::string& mesh_path, cpca::CompressOptions options,
                                  bool quiet, cpca::CompressReport* report = nullptr);
+// The same over rows visited in blocks (an out-of-core .prtx, prt/mapped_transfer.h):
+// `transfer` gives the header fields, its data is not used.
+cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const cpca::RowBlocks& data,
+                                 const meshes::Mesh& mesh, const std::string& mesh_path,
+                                 cpca::CompressOptions options, bool quiet,
+                                 cpca::CompressReport* report = nullptr);
 
 std::filesystem::path default_cache_dir();
 

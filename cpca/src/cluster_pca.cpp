@@ -7,14 +7,19 @@
 
 #include <algorithm>
 #include <atomic>
+#include <functional>
 #include <limits>
 #include <numeric>
 
 namespace cpca {
+namespace {
 
-std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
-                                    PcaSolver solver, const PowerIterationOptions& power,
-                                    ClusterPcaStats* stats) {
+// `after_cluster` runs once a cluster's rows have been gathered and used, so an out-of-core
+// source can drop the pages the gather touched.
+std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
+                                 PcaSolver solver, const PowerIterationOptions& power,
+                                 ClusterPcaStats* stats,
+                                 const std::function<void()>& after_cluster) {
   const int k = set.cluster_count, n = set.component_count;
   const Eigen::Index d = x.cols();
   set.vertex_count = std::uint64_t(x.rows());
@@ -68,9 +73,23 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
       const Eigen::RowVectorXd residual = x.row(p).cast<double>() - mean_f - wf * b;
       error[p] = residual.squaredNorm();
     }
+    if (after_cluster) after_cluster();
   });
   if (stats) stats->power_iterations = iterations;
   return error;
+}
+
+}  // namespace
+
+std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
+                                    PcaSolver solver, const PowerIterationOptions& power,
+                                    ClusterPcaStats* stats) {
+  return fit_clusters(x, set, solver, power, stats, {});
+}
+
+std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
+                                    const PowerIterationOptions& power, ClusterPcaStats* stats) {
+  return fit_clusters(x.all(), set, solver, power, stats, [&x] { x.release_all(); });
 }
 
 DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,

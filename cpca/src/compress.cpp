@@ -26,8 +26,7 @@ double sum(const std::vector<double>& v) {
 
 DataLayout resolve_layout(const DataLayout& given, Eigen::Index d);
 
-void check(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& o,
-           const Geometry* geometry) {
+void check(const RowBlocks& data, const CompressOptions& o, const Geometry* geometry) {
   auto bad = [](const std::string& what) { throw std::invalid_argument(what); };
   if (data.rows() < 1 || data.cols() < 1) bad("compress: the data is empty");
   if (o.clusters < 1 || Eigen::Index(o.clusters) > data.rows())
@@ -45,7 +44,9 @@ void check(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& o,
         " vertices but the transfer has " + std::to_string(data.rows()) +
         ": bake the transfer from this mesh again");
   resolve_layout(o.layout, data.cols());
-  if (!data.allFinite()) bad("the transfer data holds NaN or infinite values: bake it again");
+  bool finite = true;
+  data.for_each([&](Eigen::Index, const auto& block) { finite = finite && block.allFinite(); });
+  if (!finite) bad("the transfer data holds NaN or infinite values: bake it again");
 }
 
 DataLayout resolve_layout(const DataLayout& given, Eigen::Index d) {
@@ -110,7 +111,7 @@ namespace {
 using Notify = std::function<void(const char*, double)>;
 
 // Stage 1, LBG. Progress: log of the converged ratio against log of the threshold.
-LbgResult run_lbg(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+LbgResult run_lbg(const RowBlocks& data, const CompressOptions& options,
                   GeometryCoherence* coherence, const Notify& notify) {
   LbgOptions lbg_options;
   lbg_options.clusters = options.clusters;
@@ -143,7 +144,8 @@ CompressedSet new_set(const CompressOptions& options, const DataLayout& layout,
 }
 
 // Stage 3, iterative CPCA: reassign to the best-reconstructing cluster, refit, until the
-// error stops falling; a step that raises it (possible with coherence) is undone.
+// error stops falling; a step that raises it (possible with coherence) is undone. It compares
+// every point with many clusters' subspaces (V x K), so it takes the whole view, not blocks.
 void iterate_cpca(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
                   GeometryCoherence* coherence, const PowerIterationOptions& power,
                   CompressedSet& set, std::vector<double>& vertex_error, CompressReport& r,
@@ -175,11 +177,13 @@ void iterate_cpca(const Eigen::Ref<const DataMatrix>& data, const CompressOption
 }
 
 // The errors, size and triangle span of the final set.
-void measure(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
-             const Geometry* geometry, const CompressedSet& set,
-             const std::vector<double>& vertex_error, CompressReport& r) {
+void measure(const RowBlocks& data, const CompressOptions& options, const Geometry* geometry,
+             const CompressedSet& set, const std::vector<double>& vertex_error, CompressReport& r) {
   const double total = sum(vertex_error);
-  const Eigen::VectorXd row_norms = data.rowwise().squaredNorm().cast<double>();
+  Eigen::VectorXd row_norms(data.rows());
+  data.for_each([&](Eigen::Index first, const auto& block) {
+    row_norms.segment(first, block.rows()) = block.rowwise().squaredNorm().template cast<double>();
+  });
   const double norm = row_norms.sum();
   r.error.average_squared_error = total / double(data.rows());
   r.error.relative_error = norm > 0 ? total / norm : 0.0;
@@ -195,6 +199,12 @@ void measure(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& op
 }  // namespace
 
 CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                       const Geometry* geometry, CompressReport* report,
+                       const CompressProgress& progress) {
+  return compress(RowBlocks(data), options, geometry, report, progress);
+}
+
+CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
                        const Geometry* geometry, CompressReport* report,
                        const CompressProgress& progress) {
   check(data, options, geometry);
@@ -233,7 +243,7 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
   int iterations = clustering.iterations;
   if (options.method == ClusterMethod::kIterative) {
     t = Clock::now();
-    iterate_cpca(data, options, coherence.get(), power, set, vertex_error, r, notify);
+    iterate_cpca(data.all(), options, coherence.get(), power, set, vertex_error, r, notify);
     iterations += r.cpca_iterations;
     r.cpca_seconds = seconds_since(t);
     notify("cpca", 1);
@@ -243,7 +253,7 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
   if (options.overdraw_reduction) {
     t = Clock::now();
     notify("overdraw", 0);
-    r.overdraw = reduce_overdraw(data, *geometry, set, vertex_error, options.overdraw);
+    r.overdraw = reduce_overdraw(data.all(), *geometry, set, vertex_error, options.overdraw);
     vertex_error = fit_cluster_pca(data, set, options.solver, power, &stats);
     r.power_iterations += stats.power_iterations;
     r.overdraw_seconds = seconds_since(t);

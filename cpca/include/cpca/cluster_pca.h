@@ -8,6 +8,7 @@
 #include "cpca/compressed.h"
 #include "cpca/metrics.h"
 #include "cpca/power_iteration.h"
+#include "cpca/row_blocks.h"
 
 #include <vector>
 
@@ -22,6 +23,13 @@ struct ClusterPcaStats {
 // Returns each vertex's squared reconstruction error (double). Clusters run in parallel.
 std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                     PcaSolver solver, const PowerIterationOptions& power = {},
+                                    ClusterPcaStats* stats = nullptr);
+
+// The same, out of core: each cluster gathers only its own rows (random access through
+// x.all()) and the source's pages are released after every cluster, so memory holds the
+// clusters being fitted (one per thread), not the data. Bit-identical to the call above.
+std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
+                                    const PowerIterationOptions& power = {},
                                     ClusterPcaStats* stats = nullptr);
 
 // V x K: ||x_p - m_k||^2 - ||B_k (x_p - m_k)||^2 for every point and cluster, i.e. the squared

@@ -8,6 +8,7 @@
 #include "cpca/lbg.h"
 #include "cpca/metrics.h"
 #include "cpca/overdraw_reduction.h"
+#include "cpca/row_blocks.h"
 
 #include <functional>
 #include <string>
@@ -78,6 +79,14 @@ using CompressProgress = std::function<void(const std::string& stage, double fra
 // and mesh path are the caller's. Throws std::invalid_argument
 // naming the bad parameter.
 CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                       const Geometry* geometry = nullptr, CompressReport* report = nullptr,
+                       const CompressProgress& progress = {});
+
+// The same, out of core (docs/ARCHITECTURE.md "Scale"): LBG and the PCA stream over the
+// blocks (lbg.h, cluster_pca.h), so with LBG and alpha 0 memory holds one block, the
+// centroids and the clusters being fitted; geometry coherence, iterative CPCA and the
+// overdraw reduction still need V x K matrices. Bit-identical to the call above.
+CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
                        const Geometry* geometry = nullptr, CompressReport* report = nullptr,
                        const CompressProgress& progress = {});
 

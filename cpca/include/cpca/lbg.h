@@ -14,6 +14,7 @@
 
 #include "cpca/assignment.h"
 #include "cpca/metrics.h"
+#include "cpca/row_blocks.h"
 
 #include <cstdint>
 #include <functional>
@@ -43,19 +44,32 @@ using LbgCallback = std::function<void(int iteration, double energy, double rati
 LbgResult lbg(const Eigen::Ref<const DataMatrix>& x, const LbgOptions& options,
               const GeometryCoherence* coherence = nullptr, const LbgCallback& callback = {});
 
+// The same, out of core: every pass streams over the blocks (distances block x K, centroid
+// sums K x D), except that geometry coherence needs V x K distances at once. Bit-identical
+// to the in-memory call on the same rows for every block size.
+LbgResult lbg(const RowBlocks& x, const LbgOptions& options,
+              const GeometryCoherence* coherence = nullptr, const LbgCallback& callback = {});
+
 // Fills every empty cluster (ids < cluster_count) by splitting the most populated one along
 // its principal direction. Returns the number of splits. Throws std::invalid_argument when
 // there are more clusters than points.
 int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
                          std::vector<std::uint32_t>& cluster_of, int cluster_count);
+// The same, releasing the source's pages after each split's gather of the largest cluster.
+int split_empty_clusters(const RowBlocks& x, std::vector<std::uint32_t>& cluster_of,
+                         int cluster_count);
 
 // Mean of each cluster's rows (K x D), accumulated in double. Empty clusters get zero rows.
 DataMatrix cluster_means(const Eigen::Ref<const DataMatrix>& x,
                          const std::vector<std::uint32_t>& cluster_of, int cluster_count);
+DataMatrix cluster_means(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
+                         int cluster_count);
 
 // sum_p ||x_p - means[cluster_of[p]]||^2 in double, with a fixed reduction order.
 double clustering_energy(const Eigen::Ref<const DataMatrix>& x,
                          const std::vector<std::uint32_t>& cluster_of, const DataMatrix& means);
+double clustering_energy(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
+                         const DataMatrix& means);
 
 // Members of each cluster, ascending.
 std::vector<std::vector<std::uint32_t>> cluster_members(

@@ -1,0 +1,26 @@
+// apps/prtr/mpi_world.h: the MPI job this prtr process is one rank of, if any
+// (docs/ARCHITECTURE.md "Scale"). MPI is initialised only when the process was started by
+// mpirun (Open MPI sets OMPI_COMM_WORLD_SIZE) and prtr was built with PRTR_MPI; otherwise
+// the world is one rank and every call below is a no-op, so the commands need no #ifdefs.
+#pragma once
+
+#include <string>
+
+namespace prtr_app {
+
+struct MpiWorld {
+  int rank = 0, size = 1;
+};
+
+// Initialises MPI on first use (finalised at exit).
+MpiWorld mpi_world();
+bool mpi_built();
+
+void mpi_barrier();
+// The smallest `value` over all ranks.
+int mpi_min(int value);
+// Prints "rank R: message" to stderr and ends the whole job with exit status 1, so that no
+// rank waits forever for one that failed.
+[[noreturn]] void mpi_abort(const std::string& message);
+
+}  // namespace prtr_app

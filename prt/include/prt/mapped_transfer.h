@@ -1,0 +1,33 @@
+// prt/mapped_transfer.h: a .prtx read through a memory map instead of into memory, for
+// bakes larger than the memory a process should hold (prtr compress out of core,
+// docs/ARCHITECTURE.md "Scale"). It is checked as read_transfer checks a file (header,
+// size, payload checksum, finite values), but the payload is streamed through the map once
+// for that, dropping each chunk's pages after it, so opening costs no resident memory.
+#pragma once
+
+#include "common/mapped_file.h"
+#include "prt/transfer.h"
+
+#include <cstdint>
+#include <filesystem>
+
+namespace prt {
+
+class MappedTransfer {
+ public:
+  // Throws TransferFileError (prt/transfer_file.h) naming the file and the problem.
+  explicit MappedTransfer(const std::filesystem::path& path);
+
+  // Every header field, payload_checksum included; data is empty.
+  const TransferSet& header() const { return header_; }
+  // vertex_count x floats_per_vertex floats, vertex-major (prt/transfer.h).
+  const float* payload() const;
+  // Drops the pages of vertices [first, first + count) from this process (see MappedFile).
+  void release(std::uint64_t first, std::uint64_t count) const;
+
+ private:
+  TransferSet header_;
+  common::MappedFile file_;
+};
+
+}  // namespace prt

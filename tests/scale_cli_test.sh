@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# The scale paths of the prtr binary against the one-process results, byte for byte:
+#   blocks  prtr compress out of core with tiny blocks equals the default block size.
+#   mpi     mpirun -np 2 and -np 3 (oversubscribed, localhost only) prtr bake equal the
+#           one-process bake; a failing rank fails the job and leaves no output. Exit 77
+#           (skip) when prtr was built without MPI.
+# Usage: scale_cli_test.sh blocks|mpi PRTR TMPDIR [MPIEXEC]
+set -u
+mode=$1
+prtr=$2
+tmp=$3
+mpiexec=${4:-}
+rm -rf "$tmp" && mkdir -p "$tmp"
+failed=0
+check() {  # check NAME STATUS
+  if [[ $2 == 0 ]]; then echo "ok: $1"; else failed=$((failed + 1)); echo "FAIL: $1"; fi
+}
+
+# A floor of n x n vertices under a box: occlusion, so the transfer varies across vertices.
+# The blocks test needs several 256-row blocks (n = 30: 904 vertices); the MPI test few.
+n=6
+[[ $mode == blocks ]] && n=30
+mesh=$tmp/scene.obj
+{
+  for ((y = 0; y < n; ++y)); do for ((x = 0; x < n; ++x)); do
+    echo "v $x 0 $y"
+  done; done
+  for ((y = 0; y + 1 < n; ++y)); do for ((x = 0; x + 1 < n; ++x)); do
+    a=$((y * n + x + 1)); echo "f $a $((a + n)) $((a + n + 1)) $((a + 1))"
+  done; done
+  lo=$((n / 2 - 1)) hi=$((n / 2 + 1))
+  echo "v $lo 1 $lo"; echo "v $hi 1 $lo"; echo "v $hi 1 $hi"; echo "v $lo 1 $hi"
+  echo "v $lo 3 $lo"; echo "v $hi 3 $lo"; echo "v $hi 3 $hi"; echo "v $lo 3 $hi"
+  b=$((n * n))
+  echo "f $((b + 1)) $((b + 2)) $((b + 3)) $((b + 4))"; echo "f $((b + 8)) $((b + 7)) $((b + 6)) $((b + 5))"
+  echo "f $((b + 1)) $((b + 5)) $((b + 6)) $((b + 2))"; echo "f $((b + 2)) $((b + 6)) $((b + 7)) $((b + 3))"
+  echo "f $((b + 3)) $((b + 7)) $((b + 8)) $((b + 4))"; echo "f $((b + 4)) $((b + 8)) $((b + 5)) $((b + 1))"
+} >"$mesh"
+bake=(bake "$mesh" --order 3 --samples 32 --bounces 0 -q)
+
+if [[ $mode == blocks ]]; then
+  "$prtr" "${bake[@]}" -o "$tmp/one.prtx" >/dev/null; check "bake" $?
+  "$prtr" compress "$tmp/one.prtx" --mesh "$mesh" -o "$tmp/default.prtc" --clusters 24 --pcs 2 \
+    -q >/dev/null
+  check "compress, default blocks" $?
+  "$prtr" compress "$tmp/one.prtx" --mesh "$mesh" -o "$tmp/tiny.prtc" --clusters 24 --pcs 2 \
+    -q --block-vertices 1 >/dev/null
+  check "compress, --block-vertices 1" $?
+  cmp "$tmp/default.prtc" "$tmp/tiny.prtc"; check "out-of-core compress equals default" $?
+  exit $((failed > 0))
+fi
+
+if [[ -z $mpiexec ]]; then
+  echo "SKIP: prtr was built without MPI (install libopenmpi-dev and reconfigure)"
+  exit 77
+fi
+# Open MPI refuses root unless told; CI runs as a normal user, where these are not set.
+if [[ $(id -u) == 0 ]]; then
+  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+fi
+# Open MPI's runtime keeps allocations until exit; in the sanitizer build those are not ours.
+export LSAN_OPTIONS=suppressions=$(dirname "$0")/lsan_openmpi.supp:print_suppressions=0
+mpi() {  # mpi RANKS ARGS...: prtr under mpirun on this host only, shared-memory transport
+  local n=$1; shift
+  "$mpiexec" -np "$n" --oversubscribe --host "localhost:$n" --mca btl self,vader \
+    "$prtr" "$@"
+}
+
+"$prtr" "${bake[@]}" -o "$tmp/one.prtx" >/dev/null; check "one-process bake" $?
+for ranks in 2 3; do
+  mpi "$ranks" "${bake[@]}" -o "$tmp/mpi$ranks.prtx" >"$tmp/mpi$ranks.log" 2>&1
+  check "mpirun -np $ranks bake exits 0" $?
+  cmp "$tmp/one.prtx" "$tmp/mpi$ranks.prtx"; check "mpirun -np $ranks bake equals one process" $?
+  left=$(ls "$tmp" | grep -c prtshard)
+  [[ $left == 0 ]]; check "no shards left after -np $ranks" $?
+done
+# A rank that cannot write its shard (a directory in the way) fails the job, with no output.
+mkdir -p "$tmp/fail.prtx.rank1of2.prtshard"
+mpi 2 "${bake[@]}" -o "$tmp/fail.prtx" >"$tmp/fail.log" 2>&1
+[[ $? != 0 ]]; check "a failing rank fails the job" $?
+[[ ! -e $tmp/fail.prtx ]]; check "a failed job leaves no output" $?
+grep -q "rank 1 of 2" "$tmp/fail.log"; check "the failing rank is named" $?
+rmdir "$tmp/fail.prtx.rank1of2.prtshard"
+mpi 2 "${bake[@]}" -o "$tmp/fail.prtx" >"$tmp/rerun.log" 2>&1; check "a rerun succeeds" $?
+cmp "$tmp/one.prtx" "$tmp/fail.prtx"; check "the rerun equals one process" $?
+exit $((failed > 0))
