@@ -1,6 +1,8 @@
 #include "cpca/compress.h"
 
 #include "cpca/cluster_pca.h"
+#include "cpca/joint_search.h"
+#include "cpca/patch_first.h"
 
 #include <tbb/parallel_for.h>
 
@@ -198,6 +200,12 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
                        const Geometry* geometry, CompressReport* report,
                        const CompressProgress& progress) {
   check(data, options, geometry);
+  if (options.method == ClusterMethod::kPatchFirst || options.method == ClusterMethod::kJoint) {
+    if (!geometry) throw std::invalid_argument("the patch-first and joint methods need the mesh");
+    return options.method == ClusterMethod::kJoint
+               ? compress_joint(data, options, *geometry, report)
+               : compress_patch_first(data, options, *geometry, report);
+  }
   CompressReport local;
   CompressReport& r = report ? *report : local;
   r = CompressReport{};
