@@ -4,7 +4,7 @@
 // supercluster_search.h), for patch-first and joint with the passes they were designed for
 // (cpca::designed_passes).
 // Usage: pass_design_bench TRANSFER MESH [K,...] [PER_PASS,...] [ROW,...]
-//   ROW: original | patch-first | joint:LAMBDA     (defaults: 64,128,192,256  3,16
+//   ROW: original | patch-first | joint:LAMBDA | patch-joint:LAMBDA     (defaults: 64,128,192,256  3,16
 //   original,patch-first,joint:0.5)
 #include "cpca/compress.h"
 #include "cpca/patch_first.h"
@@ -40,7 +40,8 @@ Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOption
   } else if (row == "patch-first") {
     o.method = cpca::ClusterMethod::kPatchFirst;
   } else {
-    o.method = cpca::ClusterMethod::kJoint;
+    o.method = row.rfind("patch-joint", 0) == 0 ? cpca::ClusterMethod::kPatchJoint
+                                                 : cpca::ClusterMethod::kJoint;
     o.lambda = std::stod(row.substr(row.find(':') + 1));
   }
   cpca::CompressReport report;
@@ -74,7 +75,8 @@ int main(int argc, char** argv) {
   const meshes::Mesh mesh = meshes::load_mesh(argv[2]);
   cpca::Geometry g;
   g.positions = mesh.positions;
-  for (const meshes::Triangle& tri : mesh.triangles) g.triangles.push_back({tri[0], tri[1], tri[2]});
+  for (const meshes::Triangle& tri : mesh.triangles)
+    g.triangles.push_back({tri[0], tri[1], tri[2]});
   const cpca::DataMatrix x = Eigen::Map<const cpca::DataMatrix>(
       t.data.data(), Eigen::Index(t.vertex_count), Eigen::Index(t.floats_per_vertex()));
   const auto ks = split(argc > 3 ? argv[3] : "64,128,192,256");

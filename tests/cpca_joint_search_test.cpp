@@ -78,27 +78,30 @@ TEST(JointSearch, LambdaZeroIsIterativeCpca) {
 TEST(JointSearch, ObjectiveNeverRisesAndMatchesARecount) {
   const cpca::Geometry g = cpca_test::grid(kN);
   const cpca::DataMatrix x = smooth_data(g, 5);
-  for (double lambda : {0.05, 0.5, 5.0}) {
-    SCOPED_TRACE(lambda);
-    cpca::JointSearchResult search;
-    const cpca::CompressedSet set = cpca::compress_joint(
-        x, options(cpca::ClusterMethod::kJoint, lambda), g, nullptr, &search);
-    ASSERT_NO_THROW(cpca::validate(set));
-    ASSERT_GE(search.objective.size(), 2u);
-    for (std::size_t i = 1; i < search.objective.size(); ++i)
-      EXPECT_LE(search.objective[i], search.objective[i - 1]) << "stage " << i;
-    EXPECT_LT(search.objective.back(), search.objective.front());
-    // The tracked draws against a brute-force count and against cpca::overdraw.
-    const std::uint64_t drawn = brute_force_draws(set.cluster_of, g.triangles);
-    EXPECT_EQ(search.triangles_drawn, drawn);
-    EXPECT_EQ(cpca::overdraw(set.cluster_of, g.triangles, cpca::group_in_order(kClusters, kPerPass))
-                  .triangles_drawn,
-              drawn);
-    // J recomputed from the returned set by reconstruction (float round-off only).
-    const double recount = cpca::error_metrics(x, set).average_squared_error +
-                           lambda * search.error_scale * double(drawn) / double(g.triangles.size());
-    EXPECT_NEAR(search.objective.back(), recount, 1e-5 * recount);
-  }
+  for (const auto method : {cpca::ClusterMethod::kJoint, cpca::ClusterMethod::kPatchJoint})
+    for (double lambda : {0.05, 0.5, 5.0}) {
+      SCOPED_TRACE(std::string(cpca::cluster_method_name(method)) + " " + std::to_string(lambda));
+      cpca::JointSearchResult search;
+      const cpca::CompressedSet set =
+          cpca::compress_joint(x, options(method, lambda), g, nullptr, &search);
+      ASSERT_NO_THROW(cpca::validate(set));
+      ASSERT_GE(search.objective.size(), 2u);
+      for (std::size_t i = 1; i < search.objective.size(); ++i)
+        EXPECT_LE(search.objective[i], search.objective[i - 1]) << "stage " << i;
+      EXPECT_LT(search.objective.back(), search.objective.front());
+      // The tracked draws against a brute-force count and against cpca::overdraw.
+      const std::uint64_t drawn = brute_force_draws(set.cluster_of, g.triangles);
+      EXPECT_EQ(search.triangles_drawn, drawn);
+      EXPECT_EQ(
+          cpca::overdraw(set.cluster_of, g.triangles, cpca::group_in_order(kClusters, kPerPass))
+              .triangles_drawn,
+          drawn);
+      // J recomputed from the returned set by reconstruction (float round-off only).
+      const double recount =
+          cpca::error_metrics(x, set).average_squared_error +
+          lambda * search.error_scale * double(drawn) / double(g.triangles.size());
+      EXPECT_NEAR(search.objective.back(), recount, 1e-5 * recount);
+    }
 }
 
 TEST(JointSearch, LargerLambdaDrawsFewerTriangles) {

@@ -20,7 +20,8 @@ cpca::Geometry disjoint_grids(int grids, int n) {
   for (int g = 0; g < grids; ++g) {
     const cpca::Geometry one = cpca_test::grid(n);
     const auto base = std::uint32_t(all.positions.size());
-    for (Eigen::Vector3f p : one.positions) all.positions.push_back(p + Eigen::Vector3f(2.f * g, 0, 0));
+    for (Eigen::Vector3f p : one.positions)
+      all.positions.push_back(p + Eigen::Vector3f(2.f * g, 0, 0));
     for (cpca::TriangleIndices t : one.triangles)
       all.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
   }

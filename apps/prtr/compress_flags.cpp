@@ -21,7 +21,8 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
     cmd->add_option("--method", f.method,
                     "lbg: LBG then PCA per cluster; iterative: Sloan et al. 2003 iterative CPCA; "
                     "patch-first: one METIS patch per pass, CPCA inside each; joint: local "
-                    "search on Average SE + lambda x overdraw")
+                    "search on Average SE + lambda x overdraw; patch-joint: that search "
+                    "started from patch-first")
         ->check(CLI::IsMember(cpca::cluster_method_names()))
         ->capture_default_str();
   }
@@ -67,7 +68,9 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
 
 namespace {
 
-bool given(const CLI::Option* option) { return option && option->count() > 0; }
+bool given(const CLI::Option* option) {
+  return option && option->count() > 0;
+}
 
 }  // namespace
 
@@ -75,15 +78,17 @@ cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
   cpca::CompressOptions o = f.compress;
   o.method = cpca::parse_cluster_method(f.method);
   o.solver = cpca::parse_pca_solver(f.pca);
-  const bool designed =
-      o.method == cpca::ClusterMethod::kPatchFirst || o.method == cpca::ClusterMethod::kJoint;
+  const bool joint =
+      o.method == cpca::ClusterMethod::kJoint || o.method == cpca::ClusterMethod::kPatchJoint;
+  const bool designed = joint || o.method == cpca::ClusterMethod::kPatchFirst;
   if (given(f.per_pass) && !designed)
-    throw UsageError("--clusters-per-pass applies to --method patch-first or joint only");
-  if (given(f.lambda) && o.method != cpca::ClusterMethod::kJoint)
-    throw UsageError("--lambda applies to --method joint only");
-  if (o.method == cpca::ClusterMethod::kJoint && (o.alpha > 0 || o.overdraw_reduction))
     throw UsageError(
-        "--method joint weighs overdraw itself (--lambda): drop --alpha and --overdraw-reduction");
+        "--clusters-per-pass applies to --method patch-first, joint or patch-joint only");
+  if (given(f.lambda) && !joint)
+    throw UsageError("--lambda applies to --method joint or patch-joint only");
+  if (joint && (o.alpha > 0 || o.overdraw_reduction))
+    throw UsageError("--method " + f.method +
+                     " weighs overdraw itself (--lambda): drop --alpha and --overdraw-reduction");
   return o;
 }
 

@@ -1,7 +1,7 @@
 // apps/prtr/compress_flags.h: the CPCA flags (--clusters, --pcs, --method, --alpha,
 // --overdraw-reduction, --overdraw-tolerance; and for prtr compress --pca, --seed,
-// --threshold, --max-iterations, --clusters-per-pass, --lambda), registered with one help text by every command that
-// compresses: prtr compress, and prtr relight / overdraw through the cache.
+// --threshold, --max-iterations, --clusters-per-pass, --lambda), registered with one help text by
+// every command that compresses: prtr compress, and prtr relight / overdraw through the cache.
 #pragma once
 
 #include "cpca/compress.h"

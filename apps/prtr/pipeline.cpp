@@ -207,7 +207,8 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
       << o.lbg_max_iterations << " cpca " << o.cpca_threshold << ' ' << o.cpca_max_iterations << ' '
       << o.cpca_candidates;
   // Only the pass-designing methods read these; other keys stay as they were.
-  if (o.method == cpca::ClusterMethod::kPatchFirst || o.method == cpca::ClusterMethod::kJoint)
+  if (o.method == cpca::ClusterMethod::kPatchFirst || o.method == cpca::ClusterMethod::kJoint ||
+      o.method == cpca::ClusterMethod::kPatchJoint)
     key << " per-pass " << o.clusters_per_pass << " lambda " << o.lambda;
   const std::string stem = "cpca-" + hex(hash_text(key.str()));
   CompressCacheResult r;

@@ -200,11 +200,12 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
                        const Geometry* geometry, CompressReport* report,
                        const CompressProgress& progress) {
   check(data, options, geometry);
-  if (options.method == ClusterMethod::kPatchFirst || options.method == ClusterMethod::kJoint) {
+  if (options.method == ClusterMethod::kPatchFirst || options.method == ClusterMethod::kJoint ||
+      options.method == ClusterMethod::kPatchJoint) {
     if (!geometry) throw std::invalid_argument("the patch-first and joint methods need the mesh");
-    return options.method == ClusterMethod::kJoint
-               ? compress_joint(data, options, *geometry, report)
-               : compress_patch_first(data, options, *geometry, report);
+    return options.method == ClusterMethod::kPatchFirst
+               ? compress_patch_first(data, options, *geometry, report)
+               : compress_joint(data, options, *geometry, report);
   }
   CompressReport local;
   CompressReport& r = report ? *report : local;

@@ -13,7 +13,8 @@ constexpr common::EnumName<ClusterMethod> kMethodNames[] = {
     {ClusterMethod::kLbg, "lbg"},
     {ClusterMethod::kIterative, "iterative"},
     {ClusterMethod::kPatchFirst, "patch-first"},
-    {ClusterMethod::kJoint, "joint"}};
+    {ClusterMethod::kJoint, "joint"},
+    {ClusterMethod::kPatchJoint, "patch-joint"}};
 constexpr common::EnumName<PcaSolver> kSolverNames[] = {{PcaSolver::kPowerIteration, "power"},
                                                         {PcaSolver::kEigen, "eigen"}};
 }  // namespace

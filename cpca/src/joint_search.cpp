@@ -2,6 +2,7 @@
 
 #include "common/check.h"
 #include "cpca/cluster_pca.h"
+#include "cpca/patch_first.h"
 #include "cpca/supercluster_incidence.h"
 #include "cpca/supercluster_refine.h"
 #include "cpca/supercluster_strategy.h"
@@ -17,7 +18,9 @@
 namespace cpca {
 namespace {
 
-double sum(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
+double sum(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0);
+}
 
 int distinct(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
   return 1 + int(a != b) + int(c != a && c != b);
@@ -140,9 +143,8 @@ ClusterIncidence incidence_of(const CompressedSet& set, const Geometry& g, int p
 
 // One step from (set, error, pass_of); returns false (and leaves them) unless J fell.
 bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const VertexTriangles& vt,
-          const Eigen::VectorXf& norms, const JointSearchOptions& o, double mu,
-          CompressedSet& set, std::vector<double>& error, std::vector<std::uint32_t>& pass_of,
-          JointSearchResult& r) {
+          const Eigen::VectorXf& norms, const JointSearchOptions& o, double mu, CompressedSet& set,
+          std::vector<double>& error, std::vector<std::uint32_t>& pass_of, JointSearchResult& r) {
   const DataMatrix d2 = subspace_distances(data, norms, set, o.candidates);
   CompressedSet next = set;
   std::vector<std::uint32_t> next_pass = pass_of;
@@ -181,8 +183,7 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
 }
 
 // Clusters renumbered so that pass p holds [p * per_pass, ...): the order grouping.
-void renumber_by_pass(CompressedSet& set, const std::vector<std::uint32_t>& pass_of,
-                      int per_pass) {
+void renumber_by_pass(CompressedSet& set, const std::vector<std::uint32_t>& pass_of, int per_pass) {
   std::vector<std::uint32_t> id(pass_of.size());
   std::vector<std::uint32_t> used(pass_of.size(), 0);
   for (std::uint32_t c = 0; c < pass_of.size(); ++c)
@@ -198,6 +199,37 @@ void renumber_by_pass(CompressedSet& set, const std::vector<std::uint32_t>& pass
   set.means = std::move(means);
   set.bases = std::move(bases);
   for (std::uint32_t& c : set.cluster_of) c = id[c];
+}
+
+// The search's start: LBG + PCA as compress() fits them, with the METIS super-clusters
+// brought to the order profile (joint); or patch-first's set and passes (patch-joint).
+CompressedSet joint_start(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                          const Geometry& geometry, CompressReport& rep, std::vector<double>& error,
+                          std::vector<std::uint32_t>& pass_of) {
+  const bool patches = options.method == ClusterMethod::kPatchJoint;
+  CompressOptions start = options;
+  start.method = ClusterMethod::kLbg;
+  CompressedSet set = patches ? compress_patch_first(data, options, geometry, &rep)
+                              : compress(data, start, nullptr, &rep);
+  // compress() does not hand back its per-vertex errors; the same fit again gives them (for
+  // patch-first, a fit of the same clusters over the whole data).
+  PowerIterationOptions power;
+  power.seed = options.seed;
+  error = fit_cluster_pca(data, set, options.solver, power);
+  if (patches) {
+    pass_of.resize(std::size_t(set.cluster_count));
+    for (std::uint32_t c = 0; c < pass_of.size(); ++c)
+      pass_of[c] = c / std::uint32_t(options.clusters_per_pass);
+    return set;
+  }
+  SuperClusterInput input;
+  input.cluster_of = set.cluster_of;
+  input.triangles = geometry.triangles;
+  input.cluster_count = set.cluster_count;
+  input.per_pass = options.clusters_per_pass;
+  pass_of = order_profile(set.cluster_of, geometry.triangles, group_clusters("metis", input),
+                          set.cluster_count, options.clusters_per_pass);
+  return set;
 }
 
 }  // namespace
@@ -278,21 +310,9 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   CompressReport& rep = report ? *report : local;
   rep = CompressReport{};
   auto t = Clock::now();
-  CompressOptions start = options;
-  start.method = ClusterMethod::kLbg;
-  CompressedSet set = compress(data, start, nullptr, &rep);
-  // compress() does not hand back its per-vertex errors; the same fit again gives them.
-  PowerIterationOptions power;
-  power.seed = options.seed;
-  std::vector<double> error = fit_cluster_pca(data, set, options.solver, power);
-  SuperClusterInput input;
-  input.cluster_of = set.cluster_of;
-  input.triangles = geometry.triangles;
-  input.cluster_count = set.cluster_count;
-  input.per_pass = options.clusters_per_pass;
-  std::vector<std::uint32_t> pass_of =
-      order_profile(set.cluster_of, geometry.triangles, group_clusters("metis", input),
-                    set.cluster_count, options.clusters_per_pass);
+  std::vector<double> error;
+  std::vector<std::uint32_t> pass_of;
+  CompressedSet set = joint_start(data, options, geometry, rep, error, pass_of);
   const double start_seconds = seconds(t);
   t = Clock::now();
   JointSearchOptions jo;
@@ -305,7 +325,7 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   jo.seed = options.seed;
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
-  set.method = ClusterMethod::kJoint;
+  set.method = options.method;
   set.iterations += r.tried;
   rep.cpca_seconds = seconds(t);
   rep.cpca_iterations = r.tried;

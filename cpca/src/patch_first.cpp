@@ -73,9 +73,9 @@ std::vector<std::uint32_t> metis_patches(std::size_t vertices, const std::vector
   options[METIS_OPTION_NUMBERING] = 0;
   options[METIS_OPTION_SEED] = idx_t(seed & 0x7fffffff);
   options[METIS_OPTION_CONTIG] = 0;  // disjoint meshes cannot have contiguous patches
-  const int rc = METIS_PartGraphKway(&n, &constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
-                                     adjwgt.data(), &parts, share.data(), nullptr, options, &cut,
-                                     part.data());
+  const int rc =
+      METIS_PartGraphKway(&n, &constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
+                          adjwgt.data(), &parts, share.data(), nullptr, options, &cut, part.data());
   if (rc != METIS_OK)
     throw std::runtime_error("METIS_PartGraphKway failed (code " + std::to_string(rc) + ") on " +
                              std::to_string(vertices) + " vertices into " +
@@ -205,9 +205,8 @@ CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,
   set.cluster_of.assign(std::size_t(data.rows()), 0);
   set.weights.assign(std::size_t(data.rows()) * std::size_t(set.component_count), 0.f);
   set.means.assign(std::size_t(options.clusters) * set.dimension(), 0.f);
-  set.bases.assign(std::size_t(options.clusters) * std::size_t(set.component_count) *
-                       set.dimension(),
-                   0.f);
+  set.bases.assign(
+      std::size_t(options.clusters) * std::size_t(set.component_count) * set.dimension(), 0.f);
   set.iterations = 0;
   for (std::size_t p = 0; p < counts.size(); ++p) {
     stitch(parts[p], patches[p], int(p) * options.clusters_per_pass, set);
@@ -218,9 +217,8 @@ CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,
     report->lbg_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     report->error = error_metrics(data, set);
-    report->size =
-        size_metrics(std::uint64_t(data.rows()), std::uint64_t(data.cols()),
-                     std::uint64_t(options.clusters), std::uint64_t(options.components));
+    report->size = size_metrics(std::uint64_t(data.rows()), std::uint64_t(data.cols()),
+                                std::uint64_t(options.clusters), std::uint64_t(options.components));
     report->has_geometry = true;
     report->span = triangle_span(set.cluster_of, geometry.triangles);
     report->total_seconds = report->lbg_seconds;

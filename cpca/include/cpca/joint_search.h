@@ -64,13 +64,14 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
                                std::vector<std::uint32_t> pass_of,
                                const JointSearchOptions& options);
 
-// The whole method (CompressOptions::method == kJoint; compress() dispatches here): LBG and
-// PCA as compress() does, the METIS super-cluster strategy brought to order_profile, the
-// search, then clusters renumbered so that pass p holds [p * per_pass, (p + 1) * per_pass)
-// (designed_passes() in patch_first.h). Needs the geometry; alpha must be 0.
+// The whole method (CompressOptions::method kJoint or kPatchJoint; compress() dispatches
+// here). kJoint starts from LBG and PCA as compress() does, with the METIS super-cluster
+// strategy brought to order_profile; kPatchJoint from patch-first's clusters and passes. Then
+// the search, then clusters renumbered so that pass p holds [p * per_pass, (p + 1) *
+// per_pass) (designed_passes() in patch_first.h). Needs the geometry; alpha must be 0. The
+// report's pca_seconds holds the start's fit, refit and grouping, cpca_seconds the search.
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report = nullptr,
-                             JointSearchResult* search = nullptr);
+                             CompressReport* report = nullptr, JointSearchResult* search = nullptr);
 
 }  // namespace cpca
