@@ -3,9 +3,9 @@
 // by cpca::overdraw -- for original CPCA with the best existing super-cluster strategy (ILS,
 // supercluster_search.h), for patch-first and joint with the passes they were designed for
 // (cpca::designed_passes).
-// Usage: pass_design_bench TRANSFER MESH [K,...] [PER_PASS,...] [ROW,...]
-//   ROW: original | patch-first | joint:LAMBDA | patch-joint:LAMBDA     (defaults: 64,128,192,256  3,16
-//   original,patch-first,joint:0.5)
+// Usage: pass_design_bench TRANSFER MESH [K,...] [PER_PASS,...] [ROW,...] [MAX_STEPS]
+//   ROW: original | patch-first | joint:LAMBDA | patch-joint:LAMBDA     (defaults: 64,128,192,256
+//   3,16 original,patch-first,joint:0.5)
 #include "cpca/compress.h"
 #include "cpca/patch_first.h"
 #include "cpca/supercluster.h"
@@ -41,7 +41,7 @@ Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOption
     o.method = cpca::ClusterMethod::kPatchFirst;
   } else {
     o.method = row.rfind("patch-joint", 0) == 0 ? cpca::ClusterMethod::kPatchJoint
-                                                 : cpca::ClusterMethod::kJoint;
+                                                : cpca::ClusterMethod::kJoint;
     o.lambda = std::stod(row.substr(row.find(':') + 1));
   }
   cpca::CompressReport report;
@@ -85,6 +85,7 @@ int main(int argc, char** argv) {
   cpca::CompressOptions o;
   o.layout = {t.order, t.channels, t.columns()};
   o.components = 8;
+  if (argc > 6) o.cpca_max_iterations = std::stoi(argv[6]);  // iterative CPCA and search steps
   std::printf("| K | per pass | row | clustering s | Average SE | SE / original | overdraw |\n");
   std::printf("| ---: | ---: | --- | ---: | ---: | ---: | ---: |\n");
   for (const std::string& k : ks) {
