@@ -116,6 +116,18 @@ expect_code 2 && [[ $err == *--clusters* ]]; check "compress: more clusters than
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --pcs 81
 expect_code 2 && [[ $err == *--pcs* ]]; check "compress: PCs >= dimension is a usage error" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --method kmeans; expect_code 2; check "compress: unknown method is a usage error" $?
+for m in patch-first joint patch-joint; do
+  run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/pf.prtc" --clusters 4 --pcs 1 --method $m --clusters-per-pass 2 -q
+  expect_code 0 && [[ $(head -c 8 "$tmp/pf.prtc" 2>/dev/null) == PRTRCMPR ]]; check "compress --method $m writes a .prtc" $?
+done
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --lambda 1
+expect_code 2 && [[ $err == *--lambda* ]]; check "compress: --lambda without a joint method is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --method joint --lambda nan
+expect_code 2 && [[ $err == *--lambda* ]]; check "compress: --lambda nan is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --method joint --alpha 1
+expect_code 2 && [[ $err == *--alpha* ]]; check "compress: joint with --alpha is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --clusters-per-pass 2
+expect_code 2 && [[ $err == *--clusters-per-pass* ]]; check "compress: --clusters-per-pass with lbg is a usage error" $?
 run compress "$tmp/missing.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc"
 expect_code 1 && [[ $err == *missing.prtx* ]]; check "compress: missing transfer exits 1 naming it" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/quad.obj" -o "$tmp/y.prtc" --clusters 2

@@ -1,5 +1,6 @@
 #include "compress_flags.h"
 
+#include "commands.h"
 #include "cpca/compressed.h"
 #include "flag_checks.h"
 
@@ -18,7 +19,10 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
       ->capture_default_str();
   if (!per_row) {
     cmd->add_option("--method", f.method,
-                    "lbg: LBG then PCA per cluster; iterative: Sloan et al. 2003 iterative CPCA")
+                    "lbg: LBG then PCA per cluster; iterative: Sloan et al. 2003 iterative CPCA; "
+                    "patch-first: one METIS patch per pass, CPCA inside each; joint: local "
+                    "search on Average SE + lambda x overdraw; patch-joint: that search "
+                    "started from patch-first")
         ->check(CLI::IsMember(cpca::cluster_method_names()))
         ->capture_default_str();
   }
@@ -49,12 +53,42 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   cmd->add_option("--max-iterations", o.lbg_max_iterations, "LBG iteration cap")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  f.per_pass = cmd->add_option("--clusters-per-pass", o.clusters_per_pass,
+                               "patch-first / joint: clusters one render pass holds (16 at the "
+                               "default budget for order 6 and 8 PCs, 3 at the thesis's)")
+                   ->check(CLI::Range(1, 1 << 20))
+                   ->capture_default_str();
+  f.lambda = cmd->add_option("--lambda", o.lambda,
+                             "joint: overdraw weight, in units of the start's Average SE per "
+                             "unit of average overdraw (0 = iterative CPCA)")
+                 ->check(finite_number())
+                 ->check(CLI::Range(0.0, 1e6))
+                 ->capture_default_str();
 }
+
+namespace {
+
+bool given(const CLI::Option* option) {
+  return option && option->count() > 0;
+}
+
+}  // namespace
 
 cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
   cpca::CompressOptions o = f.compress;
   o.method = cpca::parse_cluster_method(f.method);
   o.solver = cpca::parse_pca_solver(f.pca);
+  const bool joint =
+      o.method == cpca::ClusterMethod::kJoint || o.method == cpca::ClusterMethod::kPatchJoint;
+  const bool designed = joint || o.method == cpca::ClusterMethod::kPatchFirst;
+  if (given(f.per_pass) && !designed)
+    throw UsageError(
+        "--clusters-per-pass applies to --method patch-first, joint or patch-joint only");
+  if (given(f.lambda) && !joint)
+    throw UsageError("--lambda applies to --method joint or patch-joint only");
+  if (joint && (o.alpha > 0 || o.overdraw_reduction))
+    throw UsageError("--method " + f.method +
+                     " weighs overdraw itself (--lambda): drop --alpha and --overdraw-reduction");
   return o;
 }
 

@@ -213,6 +213,10 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
       << ' ' << o.overdraw.max_sweeps << " seed " << o.seed << " lbg " << o.lbg_threshold << ' '
       << o.lbg_max_iterations << " cpca " << o.cpca_threshold << ' ' << o.cpca_max_iterations << ' '
       << o.cpca_candidates;
+  // Only the pass-designing methods read these; other keys stay as they were.
+  if (o.method == cpca::ClusterMethod::kPatchFirst || o.method == cpca::ClusterMethod::kJoint ||
+      o.method == cpca::ClusterMethod::kPatchJoint)
+    key << " per-pass " << o.clusters_per_pass << " lambda " << o.lambda;
   const std::string stem = "cpca-" + hex(hash_text(key.str()));
   CompressCacheResult r;
   r.path = cache_dir / (stem + ".prtc");

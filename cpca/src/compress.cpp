@@ -1,6 +1,8 @@
 #include "cpca/compress.h"
 
 #include "cpca/cluster_pca.h"
+#include "cpca/joint_search.h"
+#include "cpca/patch_first.h"
 
 #include <tbb/parallel_for.h>
 
@@ -208,6 +210,13 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
                        const Geometry* geometry, CompressReport* report,
                        const CompressProgress& progress) {
   check(data, options, geometry);
+  if (options.method == ClusterMethod::kPatchFirst || options.method == ClusterMethod::kJoint ||
+      options.method == ClusterMethod::kPatchJoint) {
+    if (!geometry) throw std::invalid_argument("the patch-first and joint methods need the mesh");
+    return options.method == ClusterMethod::kPatchFirst
+               ? compress_patch_first(data, options, *geometry, report)
+               : compress_joint(data, options, *geometry, report);
+  }
   CompressReport local;
   CompressReport& r = report ? *report : local;
   r = CompressReport{};

@@ -10,7 +10,11 @@ namespace cpca {
 
 namespace {
 constexpr common::EnumName<ClusterMethod> kMethodNames[] = {
-    {ClusterMethod::kLbg, "lbg"}, {ClusterMethod::kIterative, "iterative"}};
+    {ClusterMethod::kLbg, "lbg"},
+    {ClusterMethod::kIterative, "iterative"},
+    {ClusterMethod::kPatchFirst, "patch-first"},
+    {ClusterMethod::kJoint, "joint"},
+    {ClusterMethod::kPatchJoint, "patch-joint"}};
 constexpr common::EnumName<PcaSolver> kSolverNames[] = {{PcaSolver::kPowerIteration, "power"},
                                                         {PcaSolver::kEigen, "eigen"}};
 }  // namespace

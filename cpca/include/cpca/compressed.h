@@ -20,10 +20,14 @@ namespace cpca {
 
 // How the clusters were formed; recorded in the compressed file for reports.
 enum class ClusterMethod : std::uint32_t {
-  kLbg = 0,        // LBG / k-means on the data, PCA per cluster afterwards (thesis "original")
-  kIterative = 1,  // Sloan et al. 2003 iterative CPCA: reassign by reconstruction error
+  kLbg = 0,         // LBG / k-means on the data, PCA per cluster afterwards (thesis "original")
+  kIterative = 1,   // Sloan et al. 2003 iterative CPCA: reassign by reconstruction error
+  kPatchFirst = 2,  // mesh cut into one patch per pass, CPCA inside each (patch_first.h)
+  kJoint = 3,       // local search on error + lambda * overdraw (joint_search.h)
+  kPatchJoint = 4,  // the joint search started from patch-first's clusters and passes
 };
-const char* cluster_method_name(ClusterMethod method);  // "lbg", "iterative"
+// "lbg", "iterative", "patch-first", "joint", "patch-joint"
+const char* cluster_method_name(ClusterMethod method);
 // Throws std::invalid_argument listing the names.
 ClusterMethod parse_cluster_method(const std::string& name);
 std::vector<std::string> cluster_method_names();

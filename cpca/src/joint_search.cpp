@@ -1,0 +1,341 @@
+#include "cpca/joint_search.h"
+
+#include "common/check.h"
+#include "cpca/cluster_pca.h"
+#include "cpca/patch_first.h"
+#include "cpca/supercluster_incidence.h"
+#include "cpca/supercluster_refine.h"
+#include "cpca/supercluster_strategy.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace cpca {
+namespace {
+
+double sum(const std::vector<double>& v) {
+  return std::accumulate(v.begin(), v.end(), 0.0);
+}
+
+int distinct(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+  return 1 + int(a != b) + int(c != a && c != b);
+}
+
+// Triangles of each vertex, CSR.
+struct VertexTriangles {
+  std::vector<std::uint32_t> offset, triangle;
+  VertexTriangles(std::size_t vertices, const std::vector<TriangleIndices>& triangles)
+      : offset(vertices + 1, 0) {
+    for (const TriangleIndices& t : triangles)
+      for (std::uint32_t v : t) ++offset[v + 1];
+    for (std::size_t v = 0; v < vertices; ++v) offset[v + 1] += offset[v];
+    triangle.resize(offset.back());
+    std::vector<std::uint32_t> fill(offset.begin(), offset.end() - 1);
+    for (std::uint32_t t = 0; t < triangles.size(); ++t)
+      for (std::uint32_t v : triangles[t]) triangle[fill[v]++] = t;
+  }
+};
+
+// What the vertex sweep reads and changes.
+struct SweepState {
+  const std::vector<TriangleIndices>& triangles;
+  const VertexTriangles& incident;
+  const std::vector<std::uint32_t>& pass_of;  // per cluster
+  std::vector<std::uint32_t>& cluster_of;
+  std::vector<std::uint32_t>& size;  // members per cluster
+  double mu;                         // weight of one drawn triangle, in squared-error units
+
+  std::uint32_t pass(std::uint32_t v) const { return pass_of[cluster_of[v]]; }
+  // Draws of p's triangles if p's pass were q (a vertex listed twice in a triangle moves
+  // with itself).
+  std::int64_t draws(std::uint32_t p, std::uint32_t q) const {
+    std::int64_t n = 0;
+    for (std::uint32_t i = incident.offset[p]; i < incident.offset[p + 1]; ++i) {
+      const TriangleIndices& t = triangles[incident.triangle[i]];
+      const auto at = [&](std::uint32_t v) { return v == p ? q : pass(v); };
+      n += distinct(at(t[0]), at(t[1]), at(t[2]));
+    }
+    return n;
+  }
+};
+
+// Gauss-Seidel vertex moves with fixed bases; returns the triangles drawn it saved (may be
+// negative when error gains pay for more draws).
+std::int64_t sweep_vertices(const Eigen::Ref<const DataMatrix>& data, const DataMatrix& d2,
+                            const CompressedSet& fitted, SweepState& s, std::uint64_t& moves) {
+  std::int64_t saved = 0;
+  std::vector<std::uint32_t> extra;
+  for (std::uint32_t p = 0; p < s.cluster_of.size(); ++p) {
+    const std::uint32_t a = s.cluster_of[p];
+    if (s.size[a] <= 1) continue;
+    const std::int64_t here = s.draws(p, s.pass_of[a]);
+    double best = 0;
+    std::uint32_t best_c = a;
+    std::int64_t best_draws = here;
+    const auto consider = [&](std::uint32_t c, double err) {
+      const std::int64_t n = s.pass_of[c] == s.pass_of[a] ? here : s.draws(p, s.pass_of[c]);
+      const double delta = err - double(d2(p, a)) + s.mu * double(n - here);
+      if (delta < best) best = delta, best_c = c, best_draws = n;
+    };
+    for (Eigen::Index c = 0; c < d2.cols(); ++c)
+      if (std::uint32_t(c) != a && std::isfinite(d2(p, c))) consider(std::uint32_t(c), d2(p, c));
+    // Neighbours' clusters the nearest-mean candidates missed: the moves that cut draws.
+    extra.clear();
+    for (std::uint32_t i = s.incident.offset[p]; i < s.incident.offset[p + 1]; ++i)
+      for (std::uint32_t v : s.triangles[s.incident.triangle[i]]) {
+        const std::uint32_t c = s.cluster_of[v];
+        if (c != a && !std::isfinite(d2(p, c)) &&
+            std::find(extra.begin(), extra.end(), c) == extra.end())
+          extra.push_back(c);
+      }
+    for (std::uint32_t c : extra) consider(c, subspace_distance(data.row(p), fitted, int(c)));
+    if (best_c == a) continue;
+    --s.size[a], ++s.size[best_c];
+    s.cluster_of[p] = best_c;
+    saved += here - best_draws;
+    ++moves;
+  }
+  return saved;
+}
+
+// Best-improvement swaps between a cluster and the members of its neighbours' passes until
+// none lowers the draws. Returns the triangles drawn.
+std::uint64_t swap_descent(const ClusterIncidence& inc, int per_pass,
+                           std::vector<std::uint32_t>& pass_of, std::uint64_t& swaps) {
+  const int passes = int(*std::max_element(pass_of.begin(), pass_of.end())) + 1;
+  GroupingLocalSearch search(inc, per_pass, pass_of, passes);
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::uint32_t c = 0; c < std::uint32_t(inc.cluster_count); ++c) {
+      std::int64_t best = 0;
+      std::uint32_t partner = c;
+      for (std::uint32_t i = inc.neighbor_offset[c]; i < inc.neighbor_offset[c + 1]; ++i) {
+        const std::uint32_t q = search.pass_of()[inc.neighbor[i]];
+        if (q == search.pass_of()[c]) continue;
+        for (std::uint32_t d : search.members(q)) {
+          const std::int64_t delta = search.delta_swap(c, d);
+          if (delta < best) best = delta, partner = d;
+        }
+      }
+      if (partner == c) continue;
+      search.swap(c, partner);
+      ++swaps;
+      changed = true;
+    }
+  }
+  pass_of = search.pass_of();
+  return search.drawn();
+}
+
+ClusterIncidence incidence_of(const CompressedSet& set, const Geometry& g, int per_pass) {
+  SuperClusterInput input;
+  input.cluster_of = set.cluster_of;
+  input.triangles = g.triangles;
+  input.cluster_count = set.cluster_count;
+  input.per_pass = per_pass;
+  return cluster_incidence(input);
+}
+
+// One step from (set, error, pass_of); returns false (and leaves them) unless J fell.
+bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const VertexTriangles& vt,
+          const Eigen::VectorXf& norms, const JointSearchOptions& o, double mu, CompressedSet& set,
+          std::vector<double>& error, std::vector<std::uint32_t>& pass_of, JointSearchResult& r) {
+  const DataMatrix d2 = subspace_distances(data, norms, set, o.candidates);
+  CompressedSet next = set;
+  std::vector<std::uint32_t> next_pass = pass_of;
+  std::uint64_t moves = 0, swaps = 0;
+  std::uint64_t drawn = r.triangles_drawn;
+  if (mu == 0) {
+    // Iterative CPCA's own step (compress.cpp), so that lambda = 0 is that method.
+    next.cluster_of = argmin_rows(d2);
+    split_empty_clusters(data, next.cluster_of, set.cluster_count);
+  } else {
+    std::vector<std::uint32_t> size(std::size_t(set.cluster_count), 0);
+    for (std::uint32_t c : set.cluster_of) ++size[c];
+    SweepState s{g.triangles, vt, next_pass, next.cluster_of, size, mu};
+    drawn -= std::uint64_t(sweep_vertices(data, d2, set, s, moves));
+  }
+  PowerIterationOptions power;
+  power.seed = o.seed;
+  std::vector<double> next_error = fit_cluster_pca(data, next, o.solver, power);
+  if (mu != 0) {
+    const ClusterIncidence inc = incidence_of(next, g, o.per_pass);
+    PRTR_DCHECK(triangles_drawn(inc, next_pass) == drawn);
+    drawn = swap_descent(inc, o.per_pass, next_pass, swaps);
+  }
+  const double before = sum(error) + mu * double(r.triangles_drawn);
+  const double after = sum(next_error) + mu * double(drawn);
+  if (!(after < before)) return false;
+  set = std::move(next);
+  error = std::move(next_error);
+  pass_of = std::move(next_pass);
+  r.triangles_drawn = drawn;
+  r.vertex_moves += moves;
+  r.pass_swaps += swaps;
+  r.objective.push_back(after / double(data.rows()));
+  ++r.steps;
+  return (before - after) / before >= o.threshold;
+}
+
+// Clusters renumbered so that pass p holds [p * per_pass, ...): the order grouping.
+void renumber_by_pass(CompressedSet& set, const std::vector<std::uint32_t>& pass_of, int per_pass) {
+  std::vector<std::uint32_t> id(pass_of.size());
+  std::vector<std::uint32_t> used(pass_of.size(), 0);
+  for (std::uint32_t c = 0; c < pass_of.size(); ++c)
+    id[c] = pass_of[c] * std::uint32_t(per_pass) + used[pass_of[c]]++;
+  const std::size_t d = set.dimension(), n = std::size_t(set.component_count);
+  std::vector<float> means(set.means.size()), bases(set.bases.size());
+  for (std::uint32_t c = 0; c < pass_of.size(); ++c) {
+    std::copy_n(set.means.begin() + std::ptrdiff_t(c * d), d,
+                means.begin() + std::ptrdiff_t(id[c] * d));
+    std::copy_n(set.bases.begin() + std::ptrdiff_t(c * n * d), n * d,
+                bases.begin() + std::ptrdiff_t(id[c] * n * d));
+  }
+  set.means = std::move(means);
+  set.bases = std::move(bases);
+  for (std::uint32_t& c : set.cluster_of) c = id[c];
+}
+
+// The search's start: LBG + PCA as compress() fits them, with the METIS super-clusters
+// brought to the order profile (joint); or patch-first's set and passes (patch-joint).
+CompressedSet joint_start(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
+                          const Geometry& geometry, CompressReport& rep, std::vector<double>& error,
+                          std::vector<std::uint32_t>& pass_of) {
+  const bool patches = options.method == ClusterMethod::kPatchJoint;
+  CompressOptions start = options;
+  start.method = ClusterMethod::kLbg;
+  CompressedSet set = patches ? compress_patch_first(data, options, geometry, &rep)
+                              : compress(data, start, nullptr, &rep);
+  // compress() does not hand back its per-vertex errors; the same fit again gives them (for
+  // patch-first, a fit of the same clusters over the whole data).
+  PowerIterationOptions power;
+  power.seed = options.seed;
+  error = fit_cluster_pca(data, set, options.solver, power);
+  if (patches) {
+    pass_of.resize(std::size_t(set.cluster_count));
+    for (std::uint32_t c = 0; c < pass_of.size(); ++c)
+      pass_of[c] = c / std::uint32_t(options.clusters_per_pass);
+    return set;
+  }
+  SuperClusterInput input;
+  input.cluster_of = set.cluster_of;
+  input.triangles = geometry.triangles;
+  input.cluster_count = set.cluster_count;
+  input.per_pass = options.clusters_per_pass;
+  pass_of = order_profile(set.cluster_of, geometry.triangles, group_clusters("metis", input),
+                          set.cluster_count, options.clusters_per_pass);
+  return set;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> order_profile(const std::vector<std::uint32_t>& cluster_of,
+                                         const std::vector<TriangleIndices>& triangles,
+                                         const SuperClusters& groups, int cluster_count,
+                                         int per_pass) {
+  SuperClusterInput input;
+  input.cluster_of = cluster_of;
+  input.triangles = triangles;
+  input.cluster_count = cluster_count;
+  input.per_pass = per_pass;
+  const int passes = int(groups.passes.size());
+  if (passes != pass_count(input))
+    throw std::invalid_argument("order_profile: the grouping has " + std::to_string(passes) +
+                                " passes, not the minimum " + std::to_string(pass_count(input)));
+  const ClusterIncidence inc = cluster_incidence(input);
+  GroupingLocalSearch search(inc, per_pass, pass_of_clusters(groups, cluster_count), passes);
+  std::uint32_t last = 0;
+  for (std::uint32_t p = 1; p < std::uint32_t(passes); ++p)
+    if (search.members(p).size() < search.members(last).size()) last = p;
+  for (std::uint32_t p = 0; p < std::uint32_t(passes); ++p)
+    while (p != last && int(search.members(p).size()) < per_pass) {
+      std::int64_t best = std::numeric_limits<std::int64_t>::max();
+      std::uint32_t pick = 0;
+      for (std::uint32_t c : search.members(last))
+        if (const std::int64_t d = search.delta_move(c, p); d < best) best = d, pick = c;
+      search.move(pick, p);
+    }
+  std::vector<std::uint32_t> pass_of = search.pass_of();
+  for (std::uint32_t& p : pass_of)
+    p = p == last ? std::uint32_t(passes - 1) : p - std::uint32_t(p > last);
+  return pass_of;
+}
+
+JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const Geometry& geometry,
+                               CompressedSet& set, std::vector<double>& vertex_error,
+                               std::vector<std::uint32_t> pass_of,
+                               const JointSearchOptions& options) {
+  if (!(options.lambda >= 0) || !std::isfinite(options.lambda))
+    throw std::invalid_argument("joint search: lambda must be finite and >= 0, got " +
+                                std::to_string(options.lambda));
+  JointSearchResult r;
+  const double total = sum(vertex_error);
+  r.error_scale = total / double(data.rows());
+  const ClusterIncidence inc = incidence_of(set, geometry, options.per_pass);
+  r.triangles_drawn = triangles_drawn(inc, pass_of);
+  const double t = double(std::max<std::size_t>(geometry.triangles.size(), 1));
+  const double mu = options.lambda * total / t;
+  r.objective.push_back((total + mu * double(r.triangles_drawn)) / double(data.rows()));
+  if (mu > 0) {
+    r.triangles_drawn = swap_descent(inc, options.per_pass, pass_of, r.pass_swaps);
+    r.objective.push_back((total + mu * double(r.triangles_drawn)) / double(data.rows()));
+  }
+  const VertexTriangles vt(std::size_t(data.rows()), geometry.triangles);
+  const Eigen::VectorXf norms = data.rowwise().squaredNorm();
+  for (int i = 1; i <= options.max_steps && sum(vertex_error) > 0; ++i) {
+    r.tried = i;
+    if (!step(data, geometry, vt, norms, options, mu, set, vertex_error, pass_of, r)) break;
+  }
+  r.pass_of = std::move(pass_of);
+  return r;
+}
+
+CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
+                             const CompressOptions& options, const Geometry& geometry,
+                             CompressReport* report, JointSearchResult* search) {
+  if (options.alpha != 0 || options.overdraw_reduction)
+    throw std::invalid_argument(
+        "the joint search takes neither geometry coherence (alpha) nor the overdraw reduction: "
+        "it weighs overdraw itself (lambda)");
+  using Clock = std::chrono::steady_clock;
+  const auto seconds = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  CompressReport local;
+  CompressReport& rep = report ? *report : local;
+  rep = CompressReport{};
+  auto t = Clock::now();
+  std::vector<double> error;
+  std::vector<std::uint32_t> pass_of;
+  CompressedSet set = joint_start(data, options, geometry, rep, error, pass_of);
+  const double start_seconds = seconds(t);
+  t = Clock::now();
+  JointSearchOptions jo;
+  jo.lambda = options.lambda;
+  jo.per_pass = options.clusters_per_pass;
+  jo.max_steps = options.cpca_max_iterations;
+  jo.threshold = options.cpca_threshold;
+  jo.candidates = options.cpca_candidates;
+  jo.solver = options.solver;
+  jo.seed = options.seed;
+  JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
+  renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
+  set.method = options.method;
+  set.iterations += r.tried;
+  rep.cpca_seconds = seconds(t);
+  rep.cpca_iterations = r.tried;
+  rep.pca_seconds = start_seconds - rep.lbg_seconds;
+  rep.error = error_metrics(data, set);
+  rep.has_geometry = true;
+  rep.span = triangle_span(set.cluster_of, geometry.triangles);
+  rep.total_seconds = start_seconds + rep.cpca_seconds;
+  if (search) *search = std::move(r);
+  return set;
+}
+
+}  // namespace cpca

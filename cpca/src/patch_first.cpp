@@ -1,0 +1,229 @@
+// Patch-first CPCA: METIS patches, then CPCA inside each. METIS is included here and in
+// supercluster_metis.cpp only.
+#include "cpca/patch_first.h"
+
+#include <metis.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace cpca {
+namespace {
+
+using Edge = std::pair<std::uint32_t, std::uint32_t>;
+
+// Every mesh edge once, (low, high), sorted.
+std::vector<Edge> mesh_edges(const Geometry& g) {
+  std::vector<Edge> edges;
+  edges.reserve(g.triangles.size() * 3);
+  for (const TriangleIndices& t : g.triangles)
+    for (int i = 0; i < 3; ++i) {
+      const std::uint32_t a = t[i], b = t[(i + 1) % 3];
+      if (a != b) edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+// Similar neighbours are expensive to cut, so borders follow changes of the signal.
+std::vector<idx_t> similarity_weights(const Eigen::Ref<const DataMatrix>& data,
+                                      const std::vector<Edge>& edges) {
+  std::vector<double> d(edges.size());
+  tbb::parallel_for(std::size_t(0), edges.size(), [&](std::size_t e) {
+    d[e] = (data.row(edges[e].first) - data.row(edges[e].second)).cast<double>().squaredNorm();
+  });
+  double mean = 0;
+  for (double v : d) mean += v;
+  mean = edges.empty() ? 0.0 : mean / double(edges.size());
+  std::vector<idx_t> w(edges.size(), 1);
+  if (mean > 0)
+    for (std::size_t e = 0; e < edges.size(); ++e)
+      w[e] = 1 + idx_t(std::lround(100.0 * std::exp(-d[e] / mean)));
+  return w;
+}
+
+std::vector<std::uint32_t> metis_patches(std::size_t vertices, const std::vector<Edge>& edges,
+                                         const std::vector<idx_t>& weight,
+                                         const std::vector<int>& counts, std::uint64_t seed) {
+  std::vector<idx_t> xadj(vertices + 1, 0);
+  for (const Edge& e : edges) ++xadj[e.first + 1], ++xadj[e.second + 1];
+  for (std::size_t v = 0; v < vertices; ++v) xadj[v + 1] += xadj[v];
+  // METIS reads adjncy[0] even for a graph without edges; never hand it an empty buffer.
+  std::vector<idx_t> adjncy(std::size_t(xadj.back()) + 1, 0), adjwgt(adjncy.size(), 0);
+  std::vector<idx_t> fill(xadj.begin(), xadj.end() - 1);
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const idx_t a = idx_t(edges[e].first), b = idx_t(edges[e].second);
+    adjncy[std::size_t(fill[a])] = b, adjwgt[std::size_t(fill[a]++)] = weight[e];
+    adjncy[std::size_t(fill[b])] = a, adjwgt[std::size_t(fill[b]++)] = weight[e];
+  }
+  int total = 0;
+  for (int c : counts) total += c;
+  std::vector<real_t> share;
+  for (int c : counts) share.push_back(real_t(c) / real_t(total));
+  idx_t n = idx_t(vertices), constraints = 1, parts = idx_t(counts.size()), cut = 0;
+  std::vector<idx_t> part(vertices, 0);
+  idx_t options[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(options);
+  options[METIS_OPTION_NUMBERING] = 0;
+  options[METIS_OPTION_SEED] = idx_t(seed & 0x7fffffff);
+  options[METIS_OPTION_CONTIG] = 0;  // disjoint meshes cannot have contiguous patches
+  const int rc =
+      METIS_PartGraphKway(&n, &constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
+                          adjwgt.data(), &parts, share.data(), nullptr, options, &cut, part.data());
+  if (rc != METIS_OK)
+    throw std::runtime_error("METIS_PartGraphKway failed (code " + std::to_string(rc) + ") on " +
+                             std::to_string(vertices) + " vertices into " +
+                             std::to_string(counts.size()) + " patches");
+  return std::vector<std::uint32_t>(part.begin(), part.end());
+}
+
+// A patch needs a vertex per cluster. Short patches take vertices from patches with spare
+// ones, preferring a vertex adjacent to the short patch so that it stays compact.
+void repair_short_patches(std::vector<std::uint32_t>& patch_of, const std::vector<Edge>& edges,
+                          const std::vector<int>& counts) {
+  std::vector<std::int64_t> size(counts.size(), 0);
+  for (std::uint32_t p : patch_of) ++size[p];
+  const auto spare = [&](std::uint32_t q) { return size[q] > counts[q]; };
+  for (std::uint32_t p = 0; p < counts.size(); ++p)
+    while (size[p] < counts[p]) {
+      std::int64_t pick = -1;
+      for (const Edge& e : edges) {
+        const std::uint32_t a = patch_of[e.first], b = patch_of[e.second];
+        if (a == p && b != p && spare(b)) pick = e.second;
+        if (b == p && a != p && spare(a)) pick = e.first;
+        if (pick >= 0) break;
+      }
+      for (std::size_t v = 0; pick < 0 && v < patch_of.size(); ++v)
+        if (patch_of[v] != p && spare(patch_of[v])) pick = std::int64_t(v);
+      --size[patch_of[std::size_t(pick)]];
+      patch_of[std::size_t(pick)] = p;
+      ++size[p];
+    }
+}
+
+// The patch's rows, and its triangles renumbered into them (only those wholly inside).
+struct Patch {
+  std::vector<std::uint32_t> vertices;
+  DataMatrix data;
+  Geometry geometry;
+};
+
+Patch extract_patch(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
+                    const std::vector<std::uint32_t>& patch_of, std::uint32_t p) {
+  Patch patch;
+  std::vector<std::uint32_t> local(patch_of.size(), ~0u);
+  for (std::uint32_t v = 0; v < patch_of.size(); ++v)
+    if (patch_of[v] == p) {
+      local[v] = std::uint32_t(patch.vertices.size());
+      patch.vertices.push_back(v);
+      patch.geometry.positions.push_back(g.positions[v]);
+    }
+  patch.data.resize(Eigen::Index(patch.vertices.size()), data.cols());
+  for (std::size_t i = 0; i < patch.vertices.size(); ++i)
+    patch.data.row(Eigen::Index(i)) = data.row(patch.vertices[i]);
+  for (const TriangleIndices& t : g.triangles)
+    if (local[t[0]] != ~0u && local[t[1]] != ~0u && local[t[2]] != ~0u)
+      patch.geometry.triangles.push_back({local[t[0]], local[t[1]], local[t[2]]});
+  return patch;
+}
+
+// Copies a patch's clusters into the whole set as clusters first, first + 1, ...
+void stitch(const CompressedSet& part, const Patch& patch, int first, CompressedSet& set) {
+  const std::size_t d = set.dimension(), n = std::size_t(set.component_count);
+  for (std::size_t i = 0; i < patch.vertices.size(); ++i) {
+    const std::uint32_t v = patch.vertices[i];
+    set.cluster_of[v] = std::uint32_t(first) + part.cluster_of[i];
+    std::copy_n(part.weights.begin() + std::ptrdiff_t(i * n), n,
+                set.weights.begin() + std::ptrdiff_t(std::size_t(v) * n));
+  }
+  const std::size_t k = std::size_t(part.cluster_count);
+  std::copy_n(part.means.begin(), k * d, set.means.begin() + std::ptrdiff_t(first * d));
+  std::copy_n(part.bases.begin(), k * n * d,
+              set.bases.begin() + std::ptrdiff_t(std::size_t(first) * n * d));
+}
+
+}  // namespace
+
+std::vector<int> patch_cluster_counts(int cluster_count, int per_pass) {
+  if (cluster_count < 1 || per_pass < 1)
+    throw std::invalid_argument("patch-first: clusters and clusters per pass must be >= 1, got " +
+                                std::to_string(cluster_count) + " and " + std::to_string(per_pass));
+  std::vector<int> counts;
+  for (int left = cluster_count; left > 0; left -= per_pass)
+    counts.push_back(std::min(left, per_pass));
+  return counts;
+}
+
+std::vector<std::uint32_t> partition_patches(const Eigen::Ref<const DataMatrix>& data,
+                                             const Geometry& geometry,
+                                             const std::vector<int>& counts, std::uint64_t seed) {
+  const std::size_t vertices = std::size_t(data.rows());
+  std::int64_t total = 0;
+  for (int c : counts) total += c;
+  if (total > std::int64_t(vertices) || geometry.positions.size() != vertices)
+    throw std::invalid_argument("patch-first: " + std::to_string(total) + " clusters need as " +
+                                "many vertices, and the mesh must match the data's " +
+                                std::to_string(vertices) + " rows");
+  if (counts.size() == 1) return std::vector<std::uint32_t>(vertices, 0);
+  const std::vector<Edge> edges = mesh_edges(geometry);
+  std::vector<std::uint32_t> patch_of =
+      metis_patches(vertices, edges, similarity_weights(data, edges), counts, seed);
+  repair_short_patches(patch_of, edges, counts);
+  return patch_of;
+}
+
+CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,
+                                   const CompressOptions& options, const Geometry& geometry,
+                                   CompressReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<int> counts = patch_cluster_counts(options.clusters, options.clusters_per_pass);
+  const std::vector<std::uint32_t> patch_of =
+      partition_patches(data, geometry, counts, options.seed);
+  // Each patch is compressed alone, so the whole set is built from ordinary compressions.
+  CompressOptions inner = options;
+  inner.method = ClusterMethod::kIterative;
+  CompressedSet set;
+  std::vector<CompressedSet> parts(counts.size());
+  std::vector<Patch> patches(counts.size());
+  tbb::parallel_for(std::size_t(0), counts.size(), [&](std::size_t p) {
+    patches[p] = extract_patch(data, geometry, patch_of, std::uint32_t(p));
+    CompressOptions o = inner;
+    o.clusters = counts[p];
+    parts[p] = compress(patches[p].data, o, &patches[p].geometry);
+  });
+  set = parts.front();
+  set.method = ClusterMethod::kPatchFirst;
+  set.overdraw_reduction = options.overdraw_reduction;
+  set.cluster_count = options.clusters;
+  set.vertex_count = std::uint64_t(data.rows());
+  set.cluster_of.assign(std::size_t(data.rows()), 0);
+  set.weights.assign(std::size_t(data.rows()) * std::size_t(set.component_count), 0.f);
+  set.means.assign(std::size_t(options.clusters) * set.dimension(), 0.f);
+  set.bases.assign(
+      std::size_t(options.clusters) * std::size_t(set.component_count) * set.dimension(), 0.f);
+  set.iterations = 0;
+  for (std::size_t p = 0; p < counts.size(); ++p) {
+    stitch(parts[p], patches[p], int(p) * options.clusters_per_pass, set);
+    set.iterations = std::max(set.iterations, parts[p].iterations);
+  }
+  if (report) {
+    *report = CompressReport{};
+    report->lbg_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report->error = error_metrics(data, set);
+    report->size = size_metrics(std::uint64_t(data.rows()), std::uint64_t(data.cols()),
+                                std::uint64_t(options.clusters), std::uint64_t(options.components));
+    report->has_geometry = true;
+    report->span = triangle_span(set.cluster_of, geometry.triangles);
+    report->total_seconds = report->lbg_seconds;
+  }
+  return set;
+}
+
+}  // namespace cpca

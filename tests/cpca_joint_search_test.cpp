@@ -1,0 +1,142 @@
+// The joint search over vertex -> cluster and cluster -> pass: with lambda = 0 it is
+// iterative CPCA; its objective never rises and ends at what an independent recount of the
+// returned set gives; the draws it tracks equal a brute-force count; the pass profile is
+// the order grouping's.
+#include "cpca/joint_search.h"
+
+#include "cpca/supercluster_strategy.h"
+#include "cpca_test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <random>
+#include <set>
+
+namespace {
+
+const int kN = 20, kClusters = 14, kPerPass = 3;
+
+// Smooth transfer over a grid plus noise: clusters by signal are spatially patchy, so the
+// error-only clustering has real overdraw to trade.
+cpca::DataMatrix smooth_data(const cpca::Geometry& g, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.f, 0.05f);
+  cpca::DataMatrix x(Eigen::Index(g.positions.size()), 9);
+  for (std::size_t p = 0; p < g.positions.size(); ++p)
+    for (int i = 0; i < 9; ++i)
+      x(Eigen::Index(p), i) = std::sin(float(i + 2) * g.positions[p].x() + float(i)) *
+                                  std::cos(float(7 - i % 5) * g.positions[p].y()) +
+                              noise(rng);
+  return x;
+}
+
+cpca::CompressOptions options(cpca::ClusterMethod method, double lambda) {
+  cpca::CompressOptions o;
+  o.layout = {3, 1, 1};
+  o.clusters = kClusters;
+  o.components = 2;
+  o.method = method;
+  o.clusters_per_pass = kPerPass;
+  o.lambda = lambda;
+  o.cpca_candidates = 4;
+  return o;
+}
+
+std::uint64_t brute_force_draws(const std::vector<std::uint32_t>& cluster_of,
+                                const std::vector<cpca::TriangleIndices>& triangles) {
+  std::uint64_t drawn = 0;
+  for (const cpca::TriangleIndices& t : triangles)
+    drawn += std::set<std::uint32_t>{cluster_of[t[0]] / kPerPass, cluster_of[t[1]] / kPerPass,
+                                     cluster_of[t[2]] / kPerPass}
+                 .size();
+  return drawn;
+}
+
+TEST(JointSearch, LambdaZeroIsIterativeCpca) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 3);
+  const cpca::CompressedSet iterative =
+      cpca::compress(x, options(cpca::ClusterMethod::kIterative, 0), &g);
+  cpca::JointSearchResult search;
+  const cpca::CompressedSet joint =
+      cpca::compress_joint(x, options(cpca::ClusterMethod::kJoint, 0), g, nullptr, &search);
+  ASSERT_GE(search.steps, 1);  // the comparison means something only if the search moved
+  // The same partition under the pass renumbering, and the same numbers.
+  std::map<std::uint32_t, std::uint32_t> map;
+  for (std::size_t p = 0; p < joint.cluster_of.size(); ++p) {
+    const auto [it, fresh] = map.emplace(joint.cluster_of[p], iterative.cluster_of[p]);
+    ASSERT_EQ(it->second, iterative.cluster_of[p]) << "vertex " << p;
+  }
+  EXPECT_EQ(map.size(), std::size_t(kClusters));
+  EXPECT_EQ(joint.weights, iterative.weights);
+  EXPECT_EQ(cpca::error_metrics(x, joint).average_squared_error,
+            cpca::error_metrics(x, iterative).average_squared_error);
+  EXPECT_EQ(joint.iterations, iterative.iterations);
+}
+
+TEST(JointSearch, ObjectiveNeverRisesAndMatchesARecount) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 5);
+  for (const auto method : {cpca::ClusterMethod::kJoint, cpca::ClusterMethod::kPatchJoint})
+    for (double lambda : {0.05, 0.5, 5.0}) {
+      SCOPED_TRACE(std::string(cpca::cluster_method_name(method)) + " " + std::to_string(lambda));
+      cpca::JointSearchResult search;
+      const cpca::CompressedSet set =
+          cpca::compress_joint(x, options(method, lambda), g, nullptr, &search);
+      ASSERT_NO_THROW(cpca::validate(set));
+      ASSERT_GE(search.objective.size(), 2u);
+      for (std::size_t i = 1; i < search.objective.size(); ++i)
+        EXPECT_LE(search.objective[i], search.objective[i - 1]) << "stage " << i;
+      EXPECT_LT(search.objective.back(), search.objective.front());
+      // The tracked draws against a brute-force count and against cpca::overdraw.
+      const std::uint64_t drawn = brute_force_draws(set.cluster_of, g.triangles);
+      EXPECT_EQ(search.triangles_drawn, drawn);
+      EXPECT_EQ(
+          cpca::overdraw(set.cluster_of, g.triangles, cpca::group_in_order(kClusters, kPerPass))
+              .triangles_drawn,
+          drawn);
+      // J recomputed from the returned set by reconstruction (float round-off only).
+      const double recount =
+          cpca::error_metrics(x, set).average_squared_error +
+          lambda * search.error_scale * double(drawn) / double(g.triangles.size());
+      EXPECT_NEAR(search.objective.back(), recount, 1e-5 * recount);
+    }
+}
+
+TEST(JointSearch, LargerLambdaDrawsFewerTriangles) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 9);
+  cpca::JointSearchResult low, high;
+  cpca::compress_joint(x, options(cpca::ClusterMethod::kJoint, 0.01), g, nullptr, &low);
+  cpca::compress_joint(x, options(cpca::ClusterMethod::kJoint, 10.0), g, nullptr, &high);
+  EXPECT_LT(high.triangles_drawn, low.triangles_drawn);
+}
+
+TEST(JointSearch, OrderProfilePutsTheRoomInTheLastPass) {
+  const cpca::Geometry g = cpca_test::grid(6);
+  std::vector<std::uint32_t> cluster_of(g.positions.size());
+  for (std::size_t p = 0; p < cluster_of.size(); ++p) cluster_of[p] = std::uint32_t(p % 10);
+  cpca::SuperClusters groups;
+  groups.passes = {{0, 1}, {2, 3, 4}, {5, 6}, {7, 8, 9}};
+  groups.pass_of = cpca::pass_of_clusters(groups, 10);
+  const std::vector<std::uint32_t> pass_of =
+      cpca::order_profile(cluster_of, g.triangles, groups, 10, 3);
+  std::vector<int> size(4, 0);
+  for (std::uint32_t p : pass_of) ++size[p];
+  EXPECT_EQ(size, (std::vector<int>{3, 3, 3, 1}));
+}
+
+TEST(JointSearch, RefusesBadParameters) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 1);
+  EXPECT_THROW(cpca::compress_joint(x, options(cpca::ClusterMethod::kJoint, -1), g),
+               std::invalid_argument);
+  cpca::CompressOptions o = options(cpca::ClusterMethod::kJoint, 1);
+  o.alpha = 0.05;
+  EXPECT_THROW(cpca::compress(x, o, &g), std::invalid_argument);
+  o.alpha = 0;
+  EXPECT_THROW(cpca::compress(x, o), std::invalid_argument);  // no mesh
+}
+
+}  // namespace
