@@ -202,6 +202,19 @@ if [[ -f $forest ]]; then
   run "${od[@]}" --json; expect_code 0 && [[ $(jget - /rows/0/clusters <<<"$out") == 2 ]]; check "overdraw --json: stdout parses" $?
   ls "$tmp"/od/overdraw-K4-original-*-thesis.png >/dev/null 2>&1; check "overdraw: wrote the K=4 overdraw picture" $?
   run "${od[@]}"; expect_code 0 && [[ $out == *"(cached: "* && $out == *"came from the cache"* ]]; check "overdraw: second run uses the cached bake and compressions" $?
+  # Pass-designing rows on glmark2's cat (3,582 vertices): compressed per budget, drawn in
+  # cluster order; patch-first's designed passes overdraw less than LBG's clusters in order.
+  cat3ds=/usr/share/glmark2/models/cat.3ds
+  if [[ -f $cat3ds ]]; then
+    run overdraw "$cat3ds" --probe "$forest" --order 2 --samples 32 --bounces 0 --clusters 16 --pcs 2 \
+      --rows original,patch-first,patch-joint --strategies order --budgets thesis --frames 1 --warmup 0 \
+      --rounds 1 --width 64 --height 48 --no-modes --cache "$tmp/od_cache" --out "$tmp/odp" -q --json
+    expect_code 0; check "overdraw: patch-first and patch-joint rows run ($err)" $?
+    read -r m1 s1 o0 o1 o2 < <(jget - /rows/1/method /rows/1/strategy /rows/0/average_overdraw /rows/1/average_overdraw /rows/2/average_overdraw <<<"$out" | tr '\n' ' ')
+    [[ $m1 == patch-first && $s1 == order ]]; check "overdraw: the patch-first row is drawn in designed (cluster) order" $?
+    awk -v a="$o0" -v b="$o1" -v c="$o2" 'BEGIN { exit !(b < a && c < a && b >= 1 && c >= 1) }'
+    check "overdraw: patch-first ($o1) and patch-joint ($o2) overdraw below original in order ($o0)" $?
+  fi
   run overdraw "$tmp/cube.obj" --probe "$forest" --rows bogus; expect_code 2 && [[ $err == *--rows* ]]; check "overdraw: unknown row is a usage error" $?
   run overdraw "$tmp/cube.obj" --probe "$forest" --strategies best; expect_code 2 && [[ $err == *--strategies* ]]; check "overdraw: unknown strategy is a usage error" $?
   run overdraw "$tmp/cube.obj" --probe "$forest" --clusters 0; expect_code 2; check "overdraw: --clusters 0 is a usage error" $?

@@ -40,6 +40,10 @@ constexpr MethodPreset kMethods[] = {
      true, false},
     {"iterative", "iterative CPCA (Sloan et al. 2003) with coherence + overdraw reduction", true,
      true, true},
+    {"patch-first", "METIS patches, one per pass, CPCA inside each (designs the passes)", false,
+     false, false, cpca::ClusterMethod::kPatchFirst},
+    {"patch-joint", "patch-first, then the joint search of error + 2 x overdraw", false, false,
+     false, cpca::ClusterMethod::kPatchJoint, 2.0},
 };
 
 bool has(const std::vector<std::string>& list, const char* item) {
@@ -195,11 +199,18 @@ struct Compression {
   cpca::CompressedSet set;
   CompressionSummary summary;
   double multi_cluster_triangles = 0;
-  std::string label() const { return "K=" + std::to_string(k) + " " + method->name; }
+  // A pass-designing method's compression belongs to one budget and its clusters per pass.
+  std::string designed_budget;
+  int designed_per_pass = 0;
+  std::string label() const {
+    return "K=" + std::to_string(k) + " " + method->name +
+           (designed_budget.empty() ? "" : " (" + designed_budget + " budget)");
+  }
 };
 
+// `per_pass` is the clusters per pass a pass-designing method designs for (0 otherwise).
 Compression compress_row(const Scene& s, const std::string& transfer_path, int k,
-                         const MethodPreset& method, bool* cached) {
+                         const MethodPreset& method, int per_pass, bool* cached) {
   const OverdrawPlan& plan = s.plan;
   cpca::CompressOptions co = plan.compress;
   co.layout = {s.transfer.order, s.transfer.channels, s.transfer.columns()};
@@ -207,12 +218,18 @@ Compression compress_row(const Scene& s, const std::string& transfer_path, int k
   co.method = method.iterative ? cpca::ClusterMethod::kIterative : cpca::ClusterMethod::kLbg;
   co.alpha = method.coherence ? plan.compress.alpha : 0.0;
   co.overdraw_reduction = method.overdraw_reduction;
+  if (method.designs_passes()) {
+    co.method = method.designed;
+    co.clusters_per_pass = per_pass;
+    co.lambda = method.lambda;
+  }
   const CompressCacheResult compressed =
       cached_compress(transfer_path, s.mesh, plan.mesh, co, plan.cache, true, plan.recompress);
   *cached = compressed.hit;
   Compression c;
   c.k = k;
   c.method = &method;
+  c.designed_per_pass = method.designs_passes() ? per_pass : 0;
   c.set = cpca::read_compressed(compressed.path);
   c.summary = compressed.summary;
   const cpca::TriangleSpan span = cpca::triangle_span(c.set.cluster_of, s.geometry.triangles);
@@ -387,10 +404,16 @@ void measure_compression(const Scene& s, const Compression& c, OverdrawReport& r
   double best_overdraw = 1e300;
   cpca::SuperClusters best_groups;
   std::string best_strategy;
+  static const std::vector<std::string> kDesignedOrder{"order"};
+  const bool designed = c.designed_per_pass > 0;
   for (const std::string& budget_name : plan.budgets) {
+    if (designed && budget_name != c.designed_budget) continue;
     const int budget = budget_registers(s, budget_name, cost);
     const int per_pass = std::min(c.k, budget / cost);
-    for (const std::string& strategy : plan.strategies) {
+    if (designed && per_pass != c.designed_per_pass)
+      throw std::logic_error(c.label() + ": designed for " + std::to_string(c.designed_per_pass) +
+                             " clusters per pass, the budget holds " + std::to_string(per_pass));
+    for (const std::string& strategy : designed ? kDesignedOrder : plan.strategies) {
       progress.show(c.label() + ": " + budget_name + " budget, " + strategy);
       cpca::SuperClusters groups;
       report.rows.push_back(measure_row(s, c, budget_name, budget, per_pass, strategy, &groups));
@@ -420,6 +443,47 @@ void measure_compression(const Scene& s, const Compression& c, OverdrawReport& r
         render::overdraw_picture(
             s.mesh, s.camera,
             cpca::triangle_pass_counts(c.set.cluster_of, s.geometry.triangles, best_groups)));
+}
+
+// What one run's compressions and rows accumulate into.
+struct Rows {
+  const Scene& s;
+  OverdrawReport& report;
+  std::deque<Compression> compressions;  // deque: the timed rows point into it
+  std::vector<TimedRow> timed;
+  Progress progress;
+};
+
+// The registers one cluster of this bake will cost the renderer (render::constant_layout),
+// known before compressing: a pass-designing method needs its clusters per pass up front.
+int expected_cost(const Scene& s) {
+  const int rows = s.transfer.columns() > 1 ? s.transfer.order * s.transfer.order : 1;
+  return ((s.plan.compress.components + 1) * 3 * rows + 3) / 4;
+}
+
+// One compression (K x method, and the budget a pass-designing method designs for) and its
+// rows; `modes` also times the single-pass and decoupled paths on it.
+void measure_method(Rows& rows, int k, const MethodPreset& method, int per_pass,
+                    const std::string& budget, bool modes) {
+  const Scene& s = rows.s;
+  rows.progress.show("K=" + std::to_string(k) + " " + method.name + ": compression");
+  bool cached = false;
+  Compression& c = rows.compressions.emplace_back(
+      compress_row(s, rows.report.transfer, k, method, per_pass, &cached));
+  c.designed_budget = budget;
+  if (cached) rows.report.compressions_cached = true;
+  ++rows.progress.step;
+  if (render::constant_layout(c.set).registers_per_cluster() != expected_cost(s))
+    throw std::logic_error(c.label() + ": a cluster costs " +
+                           std::to_string(render::constant_layout(c.set).registers_per_cluster()) +
+                           " registers, not the " + std::to_string(expected_cost(s)) +
+                           " its clusters per pass were designed for");
+  if (s.plan.modes && modes)
+    for (render::Mode mode : {render::Mode::kSinglepass, render::Mode::kDecoupled}) {
+      rows.progress.show(c.label() + ": " + render::mode_name(mode));
+      rows.report.modes.push_back(measure_mode(s, c.set, k, mode));
+    }
+  measure_compression(s, c, rows.report, rows.timed, rows.progress);
 }
 
 }  // namespace
@@ -483,30 +547,26 @@ OverdrawReport run_overdraw(const OverdrawPlan& plan) {
   if (!plan.pictures.empty()) fs::create_directories(plan.pictures);
   fs::create_directories(plan.cache);
 
-  Progress progress{plan, 0,
-                    std::uint64_t(plan.clusters.size() * plan.methods.size() *
-                                  (1 + plan.budgets.size() * plan.strategies.size()))};
-  std::deque<Compression> compressions;  // deque: the timed rows point into it
-  std::vector<TimedRow> timed;
-  for (int k : plan.clusters) {
+  std::uint64_t steps = 0;
+  for (const std::string& name : plan.methods)
+    steps += find_method(name).designs_passes() ? 2 * plan.budgets.size()
+                                                : 1 + plan.budgets.size() * plan.strategies.size();
+  Rows rows{s, report, {}, {}, Progress{plan, 0, steps * plan.clusters.size()}};
+  for (int k : plan.clusters)
     for (const std::string& method_name : plan.methods) {
       const MethodPreset& method = find_method(method_name);
-      progress.show("K=" + std::to_string(k) + " " + method.name + ": compression");
-      bool cached = false;
-      const Compression& c =
-          compressions.emplace_back(compress_row(s, report.transfer, k, method, &cached));
-      if (cached) report.compressions_cached = true;
-      ++progress.step;
-      if (plan.modes && method_name == plan.methods.front()) {
-        for (render::Mode mode : {render::Mode::kSinglepass, render::Mode::kDecoupled}) {
-          progress.show(c.label() + ": " + render::mode_name(mode));
-          report.modes.push_back(measure_mode(s, c.set, k, mode));
-        }
+      if (!method.designs_passes()) {
+        measure_method(rows, k, method, 0, "", method_name == plan.methods.front());
+        continue;
       }
-      measure_compression(s, c, report, timed, progress);
+      for (const std::string& budget : plan.budgets) {
+        const int per_pass =
+            std::min(k, budget_registers(s, budget, expected_cost(s)) / expected_cost(s));
+        measure_method(rows, k, method, per_pass, budget,
+                       method_name == plan.methods.front() && budget == plan.budgets.front());
+      }
     }
-  }
-  time_rows(s, timed, report);
+  time_rows(s, rows.timed, report);
   return report;
 }
 

@@ -44,6 +44,12 @@ struct MethodPreset {
   const char* name;
   const char* summary;
   bool coherence, overdraw_reduction, iterative;
+  // Methods that design the passes while clustering (cpca/patch_first.h, joint_search.h)
+  // compress once per budget, for that budget's clusters per pass, and are drawn in cluster
+  // order (cpca::designed_passes) instead of by the super-cluster strategies.
+  cpca::ClusterMethod designed = cpca::ClusterMethod::kLbg;
+  double lambda = 0;
+  bool designs_passes() const { return designed != cpca::ClusterMethod::kLbg; }
 };
 // PlanError listing the names for an unknown one.
 const MethodPreset& find_method(const std::string& name);

@@ -214,8 +214,8 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
       options.method == ClusterMethod::kPatchJoint) {
     if (!geometry) throw std::invalid_argument("the patch-first and joint methods need the mesh");
     return options.method == ClusterMethod::kPatchFirst
-               ? compress_patch_first(data, options, *geometry, report)
-               : compress_joint(data, options, *geometry, report);
+               ? compress_patch_first(data.all(), options, *geometry, report)
+               : compress_joint(data.all(), options, *geometry, report);
   }
   CompressReport local;
   CompressReport& r = report ? *report : local;
