@@ -26,6 +26,24 @@ struct SlotPlan {
   int total_slots = 0;  // with room for a full-size range from the last pass's start
 };
 
+// A transform-feedback session writing the radiance buffer. Attribute 15 reads that buffer,
+// and a buffer both bound for feedback and enabled as a vertex source is undefined (GL 4.5
+// core, 13.2.2), so the attribute is off while the buffer is written.
+void begin_radiance_feedback(GpuMesh& mesh) {
+  glEnable(GL_RASTERIZER_DISCARD);
+  mesh.bind();
+  glDisableVertexAttribArray(kAttrRadiance);
+  glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, mesh.radiance_buffer());
+  glBeginTransformFeedback(GL_POINTS);
+}
+
+void end_radiance_feedback() {
+  glEndTransformFeedback();
+  glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+  glEnableVertexAttribArray(kAttrRadiance);
+  glDisable(GL_RASTERIZER_DISCARD);
+}
+
 // The vec4 budget of one pass, checked against the context and one cluster's cost, and the
 // clusters one pass holds. Messages name the flags, as these come from the command line.
 int clusters_per_pass(const PathInput& in, int registers) {
@@ -369,12 +387,7 @@ class MultipassPath : public ClusterPath {
   // points land at their own vertices.
   void shade_own_vertices(const Camera& camera) {
     set_camera_uniforms(shade_program_, camera);
-    glEnable(GL_RASTERIZER_DISCARD);
-    // Attribute 15 reads the buffer feedback writes: off meanwhile (GL 4.5 core, 13.2.2).
-    mesh_->bind();
-    glDisableVertexAttribArray(kAttrRadiance);
-    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, mesh_->radiance_buffer());
-    glBeginTransformFeedback(GL_POINTS);
+    begin_radiance_feedback(*mesh_);
     begin_work("feedback", mesh_->source_vertex_count());
     for (std::size_t p = 0; p + 1 < own_first_.size(); ++p) {
       const GLsizei count = own_first_[p + 1] - own_first_[p];
@@ -383,10 +396,7 @@ class MultipassPath : public ClusterPath {
       glDrawArrays(GL_POINTS, own_first_[p], count);
     }
     end_work();
-    glEndTransformFeedback();
-    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
-    glEnableVertexAttribArray(kAttrRadiance);
-    glDisable(GL_RASTERIZER_DISCARD);
+    end_radiance_feedback();
   }
 
   bool feedback_;
@@ -465,14 +475,7 @@ class DecoupledPath : public ClusterPath {
 
   void shade(const Camera& camera) {
     set_camera_uniforms(shade_program_, camera);
-    glEnable(GL_RASTERIZER_DISCARD);
-    // The feedback target is the buffer attribute 15 reads; a buffer both bound for feedback
-    // and enabled as a vertex source is undefined (GL 4.5 core, 13.2.2), so the attribute is
-    // off while the buffer is written.
-    mesh_->bind();
-    glDisableVertexAttribArray(kAttrRadiance);
-    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, mesh_->radiance_buffer());
-    glBeginTransformFeedback(GL_POINTS);
+    begin_radiance_feedback(*mesh_);
     begin_work("feedback", mesh_->vertex_count());
     for (std::size_t i = 0; i < ranges_.size(); ++i) {
       glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, offsets_[i],
@@ -480,10 +483,7 @@ class DecoupledPath : public ClusterPath {
       glDrawArrays(GL_POINTS, ranges_[i].first, ranges_[i].second);
     }
     end_work();
-    glEndTransformFeedback();
-    glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
-    glEnableVertexAttribArray(kAttrRadiance);
-    glDisable(GL_RASTERIZER_DISCARD);
+    end_radiance_feedback();
   }
 
   struct VertexRange {
