@@ -473,9 +473,9 @@ void measure_method(Rows& rows, int k, const MethodPreset& method, int per_pass,
   c.designed_budget = budget;
   if (cached) rows.report.compressions_cached = true;
   ++rows.progress.step;
-  if (render::constant_layout(c.set).registers_per_cluster() != expected_cost(s))
-    throw std::logic_error(c.label() + ": a cluster costs " +
-                           std::to_string(render::constant_layout(c.set).registers_per_cluster()) +
+  const int cost = render::constant_layout(c.set).registers_per_cluster();
+  if (cost != expected_cost(s))
+    throw std::logic_error(c.label() + ": a cluster costs " + std::to_string(cost) +
                            " registers, not the " + std::to_string(expected_cost(s)) +
                            " its clusters per pass were designed for");
   if (s.plan.modes && modes)
@@ -559,9 +559,9 @@ OverdrawReport run_overdraw(const OverdrawPlan& plan) {
         measure_method(rows, k, method, 0, "", method_name == plan.methods.front());
         continue;
       }
+      const int cost = expected_cost(s);
       for (const std::string& budget : plan.budgets) {
-        const int per_pass =
-            std::min(k, budget_registers(s, budget, expected_cost(s)) / expected_cost(s));
+        const int per_pass = std::min(k, budget_registers(s, budget, cost) / cost);
         measure_method(rows, k, method, per_pass, budget,
                        method_name == plan.methods.front() && budget == plan.budgets.front());
       }

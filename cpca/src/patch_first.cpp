@@ -1,8 +1,8 @@
-// Patch-first CPCA: METIS patches, then CPCA inside each. METIS is included here and in
-// supercluster_metis.cpp only.
+// Patch-first CPCA: METIS patches, then CPCA inside each.
 #include "cpca/patch_first.h"
 
-#include <metis.h>
+#include "metis_kway.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -32,8 +32,8 @@ std::vector<Edge> mesh_edges(const Geometry& g) {
 }
 
 // Similar neighbours are expensive to cut, so borders follow changes of the signal.
-std::vector<idx_t> similarity_weights(const Eigen::Ref<const DataMatrix>& data,
-                                      const std::vector<Edge>& edges) {
+std::vector<std::uint32_t> similarity_weights(const Eigen::Ref<const DataMatrix>& data,
+                                              const std::vector<Edge>& edges) {
   std::vector<double> d(edges.size());
   tbb::parallel_for(std::size_t(0), edges.size(), [&](std::size_t e) {
     d[e] = (data.row(edges[e].first) - data.row(edges[e].second)).cast<double>().squaredNorm();
@@ -41,46 +41,37 @@ std::vector<idx_t> similarity_weights(const Eigen::Ref<const DataMatrix>& data,
   double mean = 0;
   for (double v : d) mean += v;
   mean = edges.empty() ? 0.0 : mean / double(edges.size());
-  std::vector<idx_t> w(edges.size(), 1);
+  std::vector<std::uint32_t> w(edges.size(), 1);
   if (mean > 0)
     for (std::size_t e = 0; e < edges.size(); ++e)
-      w[e] = 1 + idx_t(std::lround(100.0 * std::exp(-d[e] / mean)));
+      w[e] = 1 + std::uint32_t(std::lround(100.0 * std::exp(-d[e] / mean)));
   return w;
 }
 
 std::vector<std::uint32_t> metis_patches(std::size_t vertices, const std::vector<Edge>& edges,
-                                         const std::vector<idx_t>& weight,
+                                         const std::vector<std::uint32_t>& weight,
                                          const std::vector<int>& counts, std::uint64_t seed) {
-  std::vector<idx_t> xadj(vertices + 1, 0);
-  for (const Edge& e : edges) ++xadj[e.first + 1], ++xadj[e.second + 1];
-  for (std::size_t v = 0; v < vertices; ++v) xadj[v + 1] += xadj[v];
-  // METIS reads adjncy[0] even for a graph without edges; never hand it an empty buffer.
-  std::vector<idx_t> adjncy(std::size_t(xadj.back()) + 1, 0), adjwgt(adjncy.size(), 0);
-  std::vector<idx_t> fill(xadj.begin(), xadj.end() - 1);
+  KwayGraph g;
+  g.offset.assign(vertices + 1, 0);
+  for (const Edge& e : edges) ++g.offset[e.first + 1], ++g.offset[e.second + 1];
+  for (std::size_t v = 0; v < vertices; ++v) g.offset[v + 1] += g.offset[v];
+  g.neighbor.resize(g.offset.back());
+  g.weight.resize(g.offset.back());
+  std::vector<std::uint32_t> fill(g.offset.begin(), g.offset.end() - 1);
   for (std::size_t e = 0; e < edges.size(); ++e) {
-    const idx_t a = idx_t(edges[e].first), b = idx_t(edges[e].second);
-    adjncy[std::size_t(fill[a])] = b, adjwgt[std::size_t(fill[a]++)] = weight[e];
-    adjncy[std::size_t(fill[b])] = a, adjwgt[std::size_t(fill[b]++)] = weight[e];
+    const std::uint32_t a = edges[e].first, b = edges[e].second;
+    g.neighbor[fill[a]] = b, g.weight[fill[a]++] = weight[e];
+    g.neighbor[fill[b]] = a, g.weight[fill[b]++] = weight[e];
   }
   int total = 0;
   for (int c : counts) total += c;
-  std::vector<real_t> share;
-  for (int c : counts) share.push_back(real_t(c) / real_t(total));
-  idx_t n = idx_t(vertices), constraints = 1, parts = idx_t(counts.size()), cut = 0;
-  std::vector<idx_t> part(vertices, 0);
-  idx_t options[METIS_NOPTIONS];
-  METIS_SetDefaultOptions(options);
-  options[METIS_OPTION_NUMBERING] = 0;
-  options[METIS_OPTION_SEED] = idx_t(seed & 0x7fffffff);
-  options[METIS_OPTION_CONTIG] = 0;  // disjoint meshes cannot have contiguous patches
-  const int rc =
-      METIS_PartGraphKway(&n, &constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
-                          adjwgt.data(), &parts, share.data(), nullptr, options, &cut, part.data());
-  if (rc != METIS_OK)
-    throw std::runtime_error("METIS_PartGraphKway failed (code " + std::to_string(rc) + ") on " +
-                             std::to_string(vertices) + " vertices into " +
-                             std::to_string(counts.size()) + " patches");
-  return std::vector<std::uint32_t>(part.begin(), part.end());
+  KwayOptions o;
+  o.parts = int(counts.size());
+  o.seed = seed;
+  for (int c : counts) o.shares.push_back(float(c) / float(total));
+  o.nodes = "vertices";
+  // METIS's default leaves patches free to be non-contiguous: disjoint meshes cannot be.
+  return metis_kway(g, o);
 }
 
 // A patch needs a vertex per cluster. Short patches take vertices from patches with spare

@@ -1,10 +1,10 @@
 // METIS 5 k-way partition of the cluster-adjacency graph, capacity repair and exact
-// refinement. METIS is included only here.
+// refinement.
 #include "cpca/supercluster_metis.h"
 
-#include "cpca/supercluster_refine.h"
+#include "metis_kway.h"
 
-#include <metis.h>
+#include "cpca/supercluster_refine.h"
 
 #include <limits>
 #include <numeric>
@@ -17,27 +17,13 @@ namespace cpca {
 namespace {
 
 std::vector<std::uint32_t> metis_parts(const ClusterIncidence& inc, int parts, int seed) {
-  idx_t vertices = inc.cluster_count, constraints = 1, nparts = parts, cut = 0;
-  std::vector<idx_t> xadj(inc.neighbor_offset.begin(), inc.neighbor_offset.end());
-  // METIS reads adjncy[0] even for a graph without edges; never hand it an empty buffer.
-  std::vector<idx_t> adjncy(inc.neighbor.begin(), inc.neighbor.end());
-  std::vector<idx_t> adjwgt(inc.neighbor_weight.begin(), inc.neighbor_weight.end());
-  adjncy.push_back(0);
-  adjwgt.push_back(0);
-  std::vector<idx_t> part(std::size_t(vertices), 0);
-  idx_t options[METIS_NOPTIONS];
-  METIS_SetDefaultOptions(options);
-  options[METIS_OPTION_NUMBERING] = 0;
-  options[METIS_OPTION_SEED] = seed;
-  options[METIS_OPTION_UFACTOR] = 1;  // 0.1% imbalance: as close to a hard capacity as it gets
-  const int rc =
-      METIS_PartGraphKway(&vertices, &constraints, xadj.data(), adjncy.data(), nullptr, nullptr,
-                          adjwgt.data(), &nparts, nullptr, nullptr, options, &cut, part.data());
-  if (rc != METIS_OK)
-    throw std::runtime_error("METIS_PartGraphKway failed (code " + std::to_string(rc) + ") on " +
-                             std::to_string(vertices) + " clusters into " + std::to_string(parts) +
-                             " parts; try another strategy");
-  return std::vector<std::uint32_t>(part.begin(), part.end());
+  KwayOptions o;
+  o.parts = parts;
+  o.seed = std::uint64_t(seed);
+  o.imbalance = 1;  // 0.1%: as close to a hard capacity as it gets
+  o.nodes = "clusters";
+  o.advice = "try another strategy";
+  return metis_kway({inc.neighbor_offset, inc.neighbor, inc.neighbor_weight}, o);
 }
 
 // Moves clusters out of parts above capacity, each time the (cluster, part with room) pair
