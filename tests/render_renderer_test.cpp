@@ -304,6 +304,32 @@ TEST(FloorHarness, MedianFrameIsPositiveAndBoundedByTheWallClock) {
   EXPECT_GT(render::floor_frame_ms(mesh, camera, o), 0.0);
 }
 
+TEST(FloorHarness, EveryFrameDrawsTheMeshUnderTheBackground) {
+  // The background pass leaves depth writes off; a harness that cleared depth without
+  // turning them back on kept frame 1's depth, so from frame 2 on the mesh failed GL_LESS
+  // and only the background was drawn (and timed). The last of three frames must still show
+  // the mesh's constant grey (0.5, alpha 1) at the centre and the probe at a corner.
+  render::GlContext ctx;
+  const meshes::Mesh mesh = meshes::make_sphere(1.f, 32, 16);
+  const render::Camera camera = render::frame_sphere(Eigen::Vector3d::Zero(), 1.0, 64, 48);
+  const probes::Probe probe = probes::make_from_function(
+      16, 8, [](const Eigen::Vector3d&) { return probes::Rgb(0.25f, 0.125f, 1.f); });
+  render::Image last;
+  render::FloorOptions o;
+  o.frames = 3;
+  o.warmup = 0;
+  o.background = &probe;
+  o.last_frame = &last;
+  render::floor_frame_ms(mesh, camera, o);
+  ASSERT_EQ(last.width, 64);
+  const float* centre = last.pixel(32, 24);
+  EXPECT_FLOAT_EQ(centre[0], 0.5f);
+  EXPECT_FLOAT_EQ(centre[3], 1.f);
+  const float* corner = last.pixel(0, 0);
+  EXPECT_NEAR(corner[2], 1.f, 1e-5);
+  EXPECT_FLOAT_EQ(corner[3], 0.f);
+}
+
 // --- Multipass equals single pass --------------------------------------------------------
 
 TEST(Renderer, MultipassEqualsSinglepassForOneTwoAndManyPasses) {

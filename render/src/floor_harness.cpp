@@ -101,6 +101,7 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
     }
     glFinish();
     if (count) *options.work = counter.read();
+    if (options.last_frame && f + 1 == options.frames) *options.last_frame = target.read();
     if (f >= 0)
       ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)

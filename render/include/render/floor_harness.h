@@ -8,6 +8,7 @@
 #include "meshes/mesh.h"
 #include "probes/probe.h"
 #include "render/camera.h"
+#include "render/image.h"
 #include "render/renderer.h"
 
 #include <vector>
@@ -23,6 +24,8 @@ struct FloorOptions {
   const probes::Probe* background = nullptr;
   // When set, the pipeline statistics of the last frame's draws (RenderStats::pass_work).
   std::vector<PassWork>* work = nullptr;
+  // When set, the last frame's image (what every timed frame drew, or should have).
+  Image* last_frame = nullptr;
 };
 
 // Median milliseconds of one clear + draw + glFinish. Needs a current GL context.
