@@ -103,7 +103,6 @@ render::RendererOptions renderer_options(const Options& o, const CLI::App* cmd) 
   ro.clusters_per_pass = o.clusters_per_pass;
   ro.cull_back_faces = !o.no_cull;
   ro.optimize_vertex_cache = !o.no_reorder;
-  ro.count_primitives = ro.mode == render::Mode::kMultipass;
   if (ro.mode == render::Mode::kUncompressed && o.transfer.empty())
     throw UsageError("--mode uncompressed needs --transfer PRTX (the raw bake)");
   if (ro.mode != render::Mode::kUncompressed && !o.transfer.empty())
@@ -232,10 +231,13 @@ Runner add_render_command(CLI::App& app) {
     renderer->set_background(background);
     const render::TimingSummary timing = render::measure(
         *renderer, camera, lighting, rotation, axis, o.degrees_per_frame, o.frames, o.warmup);
-    renderer->set_count_work(true);  // one counted frame at the timed size
+    // One counted frame at the timed size; the timed frames draw as users' frames do.
+    renderer->set_count_work(true);
+    renderer->set_count_primitives(ro.mode == render::Mode::kMultipass);
     renderer->render(camera, lighting, rotation);
     const render::RenderStats counted = renderer->stats();
     renderer->set_count_work(false);
+    renderer->set_count_primitives(false);
     const render::Camera image_camera = render::supersampled(camera, o.supersample);
     const double image_ms = renderer->render(image_camera, lighting, rotation).total_ms;
     const render::Image image = render::box_downsample(renderer->read_image(), o.supersample);

@@ -194,6 +194,46 @@ class ClusterPath : public RenderPath {
 
   GLsizeiptr cluster_bytes() const { return GLsizeiptr(layout_.registers_per_cluster()) * 16; }
 
+  // One cluster's vertices (contiguous, as vertices are sorted by slot) and the byte offset
+  // of its constants.
+  struct ClusterRange {
+    GLint first = 0;
+    GLsizei count = 0;
+    GLintptr offset = 0;
+  };
+  // The clusters' ranges over GPU vertices [0, vertices), in slot order.
+  std::vector<ClusterRange> cluster_ranges(std::size_t vertices) const {
+    std::vector<std::uint32_t> slot_order(plan_.slot_of);
+    std::sort(slot_order.begin(), slot_order.end());
+    std::vector<ClusterRange> ranges;
+    std::size_t v = 0;
+    for (std::uint32_t slot : slot_order) {
+      const std::size_t first = v;
+      while (v < vertices && gpu_set_.cluster_of[v] == slot) ++v;
+      if (v > first)
+        ranges.push_back({GLint(first), GLsizei(v - first), GLintptr(slot) * cluster_bytes()});
+    }
+    PRTR_DCHECK(v == vertices);  // every vertex in exactly one cluster range
+    return ranges;
+  }
+
+  // Each range's vertices once, as points with only its cluster's constants bound, so
+  // `program` (ConstantAccess::kUniformFixed) indexes them by literals; transform feedback
+  // writes the radiance at the vertices' own indices (the ranges follow each other from 0).
+  void shade_by_feedback(GlProgram& program, const Camera& camera,
+                         const std::vector<ClusterRange>& ranges, std::size_t vertices) {
+    set_camera_uniforms(program, camera);
+    begin_radiance_feedback(*mesh_);
+    begin_work("feedback", vertices);
+    for (const ClusterRange& r : ranges) {
+      glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, r.offset,
+                        cluster_bytes());
+      glDrawArrays(GL_POINTS, r.first, r.count);
+    }
+    end_work();
+    end_radiance_feedback();
+  }
+
   ShadingConstants constants_;
   ConstantLayout layout_;
   SlotPlan plan_;
@@ -271,50 +311,62 @@ class ClusterPath : public RenderPath {
   }
 };
 
-// Depth pre-pass, then one additive pass per super-cluster with GL_EQUAL depth, each binding
-// only its clusters' constants (one UBO range) and drawing only its own triangles. With
-// multipass_feedback, each pass's shading is split in two: its own vertices (one contiguous
-// range, as vertices are sorted by slot) shaded once as points into the radiance buffer, then
-// its triangles drawn pass-through, other passes' corners reading a zero copy. llvmpipe's
-// vertex stage masks a branch rather than skipping it, so in-draw shading paid the whole
-// reconstruction for every foreign corner, and a triangle draw's vertex stage cost ~2.6x a
-// points draw's per vertex (docs/ARCHITECTURE.md "Rendering").
+// Depth pre-pass, then one additive pass per super-cluster with GL_EQUAL depth, each drawing
+// only its own triangles with only its clusters' constants in use. With multipass_feedback,
+// each pass's shading is split in two: its own vertices are shaded once as points into the
+// radiance buffer by transform feedback, cluster by cluster (a contiguous range each, as
+// vertices are sorted by slot) with that cluster's part of the pass's constants bound, so
+// every register index is a literal; then its triangles are drawn pass-through, other
+// passes' corners reading a zero copy. llvmpipe's vertex stage masks a branch rather than
+// skipping it, so in-draw shading paid the whole reconstruction for every foreign corner; a
+// triangle draw's vertex stage cost ~2.6x a points draw's per vertex; and a per-vertex
+// register index ~3x a literal one in a points draw (docs/ARCHITECTURE.md "Rendering").
 class MultipassPath : public ClusterPath {
  public:
   explicit MultipassPath(const PathInput& in)
-      : ClusterPath(in, true, false, in.options.multipass_feedback, !in.options.multipass_feedback,
-                    true, in.options.multipass_feedback),
+      : ClusterPath(in, true, in.options.multipass_feedback, in.options.multipass_feedback,
+                    !in.options.multipass_feedback, true, in.options.multipass_feedback),
         feedback_(in.options.multipass_feedback) {
     std::vector<cpca::TriangleIndices> tris(in.mesh.triangles.begin(), in.mesh.triangles.end());
     const cpca::OverdrawStats od = cpca::overdraw(in.set->cluster_of, tris, plan_.groups);
     in.stats.triangles_per_pass = od.triangles_per_pass;
     in.stats.average_overdraw = od.average_overdraw;
     in.stats.passes = int(plan_.groups.passes.size());
-    // Within a pass the shader indexes by the slot relative to the pass's range.
+    // Within a pass the in-draw shader indexes by the slot relative to the pass's range.
     std::vector<std::uint32_t> relative = slots();
     for (std::size_t i = 0; i < relative.size(); ++i)
       relative[i] -= std::uint32_t(plan_.pass_offset[pass_of_vertex_[i]] / cluster_bytes());
     upload(relative, GL_UNIFORM_BUFFER, true);
     depth_program_ =
         GlProgram("depth pre-pass", position_vertex_shader(), coverage_fragment_shader());
-    shade_program_ = GlProgram("multipass shading",
-                               compressed_vertex_shader(layout_, ConstantAccess::kUniformSlot,
-                                                        plan_.slots_per_pass, !feedback_),
-                               radiance_fragment_shader(), true);
+    if (feedback_)
+      shade_program_ =
+          GlProgram("multipass shading",
+                    compressed_vertex_shader(layout_, ConstantAccess::kUniformFixed, 1, false),
+                    radiance_fragment_shader(), true);
+    else
+      shade_program_ = GlProgram("multipass in-draw shading",
+                                 compressed_vertex_shader(layout_, ConstantAccess::kUniformSlot,
+                                                          plan_.slots_per_pass, true),
+                                 radiance_fragment_shader(), true);
     if (feedback_) prepare_feedback();
   }
 
   std::size_t passes() const override { return pass_ranges_.size(); }
   bool pass_drew(std::size_t p) const override { return pass_ranges_[p].count > 0; }
 
-  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
-    if (feedback_) shade_own_vertices(camera);
+  bool draw_depth(const Camera& camera) override {
     set_camera_uniforms(depth_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);  // rgb = 0, alpha = coverage
     glDepthFunc(GL_LESS);
     begin_work("depth", whole_.referenced);
     mesh_->draw(whole_);
     end_work();
+    return true;
+  }
+
+  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
+    if (feedback_) shade_own_vertices(camera);
     set_camera_uniforms(feedback_ ? passthrough_program_ : shade_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
     glDepthFunc(GL_EQUAL);
@@ -368,14 +420,11 @@ class MultipassPath : public ClusterPath {
                       GLsizeiptr(plan_.slots_per_pass) * cluster_bytes());
   }
 
-  // Each pass's own vertex range (mesh vertices are sorted by pass), and zeros in the radiance
-  // buffer, which feedback never writes past the mesh vertices: the zero copies' radiance.
+  // The clusters' ranges over the mesh vertices, in pass order (slots are assigned pass by
+  // pass), and zeros in the radiance buffer, which feedback never writes past the mesh
+  // vertices: the zero copies' radiance.
   void prepare_feedback() {
-    const std::size_t V = mesh_->source_vertex_count();
-    own_first_.assign(plan_.pass_offset.size() + 1, GLint(V));
-    for (std::size_t i = V; i-- > 0;) own_first_[pass_of_vertex_[i]] = GLint(i);
-    for (std::size_t p = plan_.pass_offset.size(); p-- > 0;)
-      own_first_[p] = std::min(own_first_[p], own_first_[p + 1]);
+    own_ranges_ = cluster_ranges(mesh_->source_vertex_count());
     const std::vector<float> zeros(mesh_->vertex_count() * 3, 0.f);
     glBindBuffer(GL_ARRAY_BUFFER, mesh_->radiance_buffer());
     glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(zeros.size() * 4), zeros.data());
@@ -383,24 +432,12 @@ class MultipassPath : public ClusterPath {
         GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
   }
 
-  // One feedback session: the passes' ranges follow each other from vertex 0, so the captured
-  // points land at their own vertices.
   void shade_own_vertices(const Camera& camera) {
-    set_camera_uniforms(shade_program_, camera);
-    begin_radiance_feedback(*mesh_);
-    begin_work("feedback", mesh_->source_vertex_count());
-    for (std::size_t p = 0; p + 1 < own_first_.size(); ++p) {
-      const GLsizei count = own_first_[p + 1] - own_first_[p];
-      if (count == 0) continue;
-      bind_pass(p);
-      glDrawArrays(GL_POINTS, own_first_[p], count);
-    }
-    end_work();
-    end_radiance_feedback();
+    shade_by_feedback(shade_program_, camera, own_ranges_, mesh_->source_vertex_count());
   }
 
   bool feedback_;
-  std::vector<GLint> own_first_;  // pass p's own vertices: [own_first_[p], own_first_[p + 1])
+  std::vector<ClusterRange> own_ranges_;
   GlProgram depth_program_, shade_program_, passthrough_program_;
 };
 
@@ -433,7 +470,7 @@ class DecoupledPath : public ClusterPath {
  public:
   explicit DecoupledPath(const PathInput& in) : ClusterPath(in, true, true, true, false, true) {
     upload(slots(), GL_UNIFORM_BUFFER, true);
-    find_cluster_ranges(in.set->cluster_count);
+    ranges_ = cluster_ranges(mesh_->vertex_count());
     shade_program_ =
         GlProgram("decoupled shading",
                   compressed_vertex_shader(layout_, ConstantAccess::kUniformFixed, 1, false),
@@ -442,56 +479,18 @@ class DecoupledPath : public ClusterPath {
         GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
   }
   void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
-    shade(camera);
+    shade_by_feedback(shade_program_, camera, ranges_, mesh_->vertex_count());
     draw_whole(passthrough_program_, camera, queries);
   }
   std::vector<Rgb> capture(const Camera& camera) override {
-    shade(camera);
+    shade_by_feedback(shade_program_, camera, ranges_, mesh_->vertex_count());
     std::vector<Rgb> radiance;
     mesh_->read(mesh_->radiance_buffer(), radiance, false);
     return radiance;
   }
 
  private:
-  void find_cluster_ranges(int cluster_count) {
-    std::vector<std::uint32_t> by_slot{};
-    by_slot.resize(std::size_t(cluster_count));
-    std::iota(by_slot.begin(), by_slot.end(), 0u);
-    std::sort(by_slot.begin(), by_slot.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return plan_.slot_of[a] < plan_.slot_of[b];
-    });
-    const std::size_t V = mesh_->vertex_count();
-    std::size_t v = 0;
-    for (std::uint32_t k : by_slot) {
-      const std::size_t first = v;
-      while (v < V && gpu_set_.cluster_of[v] == plan_.slot_of[k]) ++v;
-      if (v > first) {
-        ranges_.push_back({GLint(first), GLsizei(v - first)});
-        offsets_.push_back(GLintptr(plan_.slot_of[k]) * cluster_bytes());
-      }
-    }
-    PRTR_DCHECK(v == V);  // every vertex in exactly one cluster range
-  }
-
-  void shade(const Camera& camera) {
-    set_camera_uniforms(shade_program_, camera);
-    begin_radiance_feedback(*mesh_);
-    begin_work("feedback", mesh_->vertex_count());
-    for (std::size_t i = 0; i < ranges_.size(); ++i) {
-      glBindBufferRange(GL_UNIFORM_BUFFER, kConstantsBinding, constant_buffer_, offsets_[i],
-                        cluster_bytes());
-      glDrawArrays(GL_POINTS, ranges_[i].first, ranges_[i].second);
-    }
-    end_work();
-    end_radiance_feedback();
-  }
-
-  struct VertexRange {
-    GLint first;
-    GLsizei second;
-  };
-  std::vector<VertexRange> ranges_;
-  std::vector<GLintptr> offsets_;  // bytes, one per range
+  std::vector<ClusterRange> ranges_;
   GlProgram shade_program_, passthrough_program_;
 };
 

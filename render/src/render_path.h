@@ -30,6 +30,10 @@ class RenderPath {
   // Draws the mesh into the bound, cleared framebuffer (depth test and culling set); with
   // `queries` (one per pass()), counts each pass's primitives.
   virtual void draw(const Camera& camera, const std::vector<GLuint>& queries) = 0;
+  // A depth pre-pass that draw() relies on, if the path has one: drawn first, so that the
+  // renderer can draw the background (where depth stays 1) and flush both to llvmpipe's
+  // rasterizer threads while draw() shades vertices on this one. False: none drawn.
+  virtual bool draw_depth(const Camera&) { return false; }
   // The per-vertex radiance the vertex stage produces, in GPU vertex order.
   virtual std::vector<Rgb> capture(const Camera& camera) = 0;
 

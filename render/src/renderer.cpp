@@ -144,13 +144,23 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
   }
   work.reset();
   path->set_work_counter(options.count_work ? &work : nullptr);
-  path->draw(camera, options.count_primitives ? queries : std::vector<GLuint>{});
-  // Background where no triangle wrote depth (depth is still the cleared 1.0).
-  if (probe_background) {
+  // Background where no triangle wrote depth (depth is still the cleared 1.0): right after a
+  // depth pre-pass, flushed so that it rasterizes while the path shades, else after the path.
+  auto draw_background = [&] {
+    if (!probe_background) return;
     if (options.count_work) work.begin("background", 3);
     background_pass.draw(camera, rotation_matrix);
     if (options.count_work) work.end();
+    if (options.cull_back_faces) glEnable(GL_CULL_FACE);  // the background pass turns it off
+    path->mesh().bind();
+  };
+  const bool depth_first = path->draw_depth(camera);
+  if (depth_first) {
+    draw_background();
+    glFlush();
   }
+  path->draw(camera, options.count_primitives ? queries : std::vector<GLuint>{});
+  if (!depth_first) draw_background();
   glDepthMask(GL_TRUE);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   path->mesh().bind();
@@ -182,6 +192,10 @@ void Renderer::set_probe(const probes::Probe* probe) {
 
 void Renderer::set_count_work(bool on) {
   impl_->options.count_work = on;
+}
+
+void Renderer::set_count_primitives(bool on) {
+  impl_->options.count_primitives = on;
 }
 
 FrameTiming Renderer::render(const Camera& camera,

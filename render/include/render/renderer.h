@@ -68,7 +68,8 @@ struct RendererOptions {
   // order) to measure the difference.
   bool renumber_vertices = true;
   // Multipass: each pass first shades its own vertices as points into the radiance buffer
-  // (transform feedback, only the pass's constants bound), then draws its triangles
+  // (transform feedback, cluster by cluster with only that cluster's part of the pass's
+  // constants bound, so every register index is a literal), then draws its triangles
   // pass-through, the other passes' corners reading a zero copy. false shades in the
   // triangle draws' vertex stage (own and foreign corners alike), to measure the difference.
   bool multipass_feedback = true;
@@ -136,6 +137,9 @@ class Renderer {
   // RendererOptions::count_work for the following frames (timing frames leave it off so the
   // queries cost nothing there).
   void set_count_work(bool on);
+  // RendererOptions::count_primitives for the following frames, likewise: a query per pass
+  // makes multipass draw pass by pass instead of in one call.
+  void set_count_primitives(bool on);
 
   // Draws one frame (waits for it with glFinish) and returns its timing.
   FrameTiming render(const Camera& camera, const Eigen::Ref<const prt::ShLighting>& lighting,
