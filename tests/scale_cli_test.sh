@@ -17,9 +17,9 @@ check() {  # check NAME STATUS
 }
 
 # A floor of n x n vertices under a box: occlusion, so the transfer varies across vertices.
-# The blocks test needs several 256-row blocks (n = 30: 904 vertices); the MPI test few.
-n=6
-[[ $mode == blocks ]] && n=30
+# Both tests need several 256-row blocks (n = 30: 908 vertices): the blocks test to split the
+# passes, the MPI test to give each of 3 ranks rows of its own (ranks own multiples of 256).
+n=30
 mesh=$tmp/scene.obj
 {
   for ((y = 0; y < n; ++y)); do for ((x = 0; x < n; ++x)); do
@@ -88,4 +88,25 @@ grep -q "rank 1 of 2" "$tmp/fail.log"; check "the failing rank is named" $?
 rmdir "$tmp/fail.prtx.rank1of2.prtshard"
 mpi 2 "${bake[@]}" -o "$tmp/fail.prtx" >"$tmp/rerun.log" 2>&1; check "a rerun succeeds" $?
 cmp "$tmp/one.prtx" "$tmp/fail.prtx"; check "the rerun equals one process" $?
+
+# Compression: chained LBG sums and PCA spread over the ranks give the one-process bytes, for
+# any block size (--block-vertices 1: 256-row blocks inside each rank's rows).
+compress=(compress "$tmp/one.prtx" --mesh "$mesh" --clusters 24 --pcs 2 -q)
+"$prtr" "${compress[@]}" -o "$tmp/one.prtc" --json >"$tmp/one.json"; check "one-process compress" $?
+grep -q '"splits":[1-9]' "$tmp/one.json"; check "the compression splits null clusters" $?
+for ranks in 2 3; do
+  for blocks in 0 1; do
+    out=$tmp/mpi$ranks-$blocks.prtc
+    mpi "$ranks" "${compress[@]}" --block-vertices $blocks -o "$out" >"$tmp/c$ranks.log" 2>&1
+    check "mpirun -np $ranks compress --block-vertices $blocks exits 0" $?
+    cmp "$tmp/one.prtc" "$out"; check "mpirun -np $ranks compress equals one process" $?
+  done
+done
+mpi 2 "${compress[@]}" --method iterative -o "$tmp/it.prtc" >"$tmp/it.log" 2>&1
+[[ $? == 2 ]]; check "mpirun compress refuses --method iterative (exit 2)" $?
+grep -q "method lbg" "$tmp/it.log"; check "the refusal says what runs" $?
+mkdir -p "$tmp/dir.prtc"
+mpi 2 "${compress[@]}" -o "$tmp/dir.prtc" >"$tmp/cfail.log" 2>&1
+[[ $? != 0 ]]; check "a compress whose rank 0 cannot write fails the job" $?
+grep -q "rank 0 of 2" "$tmp/cfail.log"; check "the failing compress rank is named" $?
 exit $((failed > 0))

@@ -4,6 +4,9 @@
 // the world is one rank and every call below is a no-op, so the commands need no #ifdefs.
 #pragma once
 
+#include "cpca/distribution.h"
+
+#include <memory>
 #include <string>
 
 namespace prtr_app {
@@ -19,6 +22,11 @@ bool mpi_built();
 void mpi_barrier();
 // The smallest `value` over all ranks.
 int mpi_min(int value);
+// The world as a cpca::Distribution, for a compression spread over the ranks. Its
+// exchanges poll with short sleeps, like mpi_barrier, so a waiting rank leaves its core to
+// the ranks still computing. Throws std::runtime_error without MPI.
+std::unique_ptr<cpca::Distribution> mpi_distribution();
+
 // Prints "rank R: message" to stderr and ends the whole job with exit status 1, so that no
 // rank waits forever for one that failed.
 [[noreturn]] void mpi_abort(const std::string& message);

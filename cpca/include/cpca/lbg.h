@@ -13,6 +13,7 @@
 #pragma once
 
 #include "cpca/assignment.h"
+#include "cpca/distribution.h"
 #include "cpca/metrics.h"
 #include "cpca/row_blocks.h"
 
@@ -49,6 +50,12 @@ LbgResult lbg(const Eigen::Ref<const DataMatrix>& x, const LbgOptions& options,
 // to the in-memory call on the same rows for every block size.
 LbgResult lbg(const RowBlocks& x, const LbgOptions& options,
               const GeometryCoherence* coherence = nullptr, const LbgCallback& callback = {});
+
+// The same spread over the ranks of `distribution` (no geometry coherence): each rank
+// assigns its rank_rows; the centroid sums, energy and hyper box are chained
+// (distribution.h), so every rank returns the result of the one-process call bit for bit.
+LbgResult lbg(const RowBlocks& x, const LbgOptions& options, Distribution& distribution,
+              const LbgCallback& callback = {});
 
 // Fills every empty cluster (ids < cluster_count) by splitting the most populated one along
 // its principal direction. Returns the number of splits. Throws std::invalid_argument when
