@@ -78,6 +78,13 @@ double clustering_energy(const Eigen::Ref<const DataMatrix>& x,
 double clustering_energy(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
                          const DataMatrix& means);
 
+// The same two spread over ranks (each its rank_rows, chained), equal to the calls above bit
+// for bit on every rank. `cluster_of` holds every row's id on every rank.
+DataMatrix cluster_means(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
+                         int cluster_count, Distribution& distribution);
+double clustering_energy(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
+                         const DataMatrix& means, Distribution& distribution);
+
 // Members of each cluster, ascending.
 std::vector<std::vector<std::uint32_t>> cluster_members(
     const std::vector<std::uint32_t>& cluster_of, int cluster_count);
