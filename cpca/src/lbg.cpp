@@ -96,26 +96,27 @@ DataMatrix chained_means(const RowBlocks& x, RowRange mine, Distribution& dist,
 double chained_energy(const RowBlocks& x, RowRange mine, Distribution& dist,
                       const std::vector<std::uint32_t>& cluster_of, const DataMatrix& means) {
   constexpr Eigen::Index kChunk = 1024;
+  // The terms before the chain, so that only the cheap running sum waits for rank r - 1.
+  std::vector<double> term(std::size_t(mine.size()));
+  x.for_each_in(mine.begin, mine.end, [&](Eigen::Index first, const auto& block) {
+    tbb::parallel_for(Eigen::Index(0), block.rows(), [&](Eigen::Index i) {
+      term[std::size_t(first - mine.begin + i)] =
+          (block.row(i) - means.row(cluster_of[std::size_t(first + i)]))
+              .template cast<double>()
+              .squaredNorm();
+    });
+  });
   std::vector<double> state = {0.0, 0.0};  // total, open chunk
-  std::vector<double> term;
   chain(dist, state, [&](std::vector<double>&) {
     double& total = state[0];
     double& chunk = state[1];
-    x.for_each_in(mine.begin, mine.end, [&](Eigen::Index first, const auto& block) {
-      term.resize(std::size_t(block.rows()));
-      tbb::parallel_for(Eigen::Index(0), block.rows(), [&](Eigen::Index i) {
-        term[std::size_t(i)] = (block.row(i) - means.row(cluster_of[std::size_t(first + i)]))
-                                   .template cast<double>()
-                                   .squaredNorm();
-      });
-      for (Eigen::Index i = 0; i < block.rows(); ++i) {
-        chunk += term[std::size_t(i)];
-        if ((first + i + 1) % kChunk == 0) {
-          total += chunk;
-          chunk = 0;
-        }
+    for (Eigen::Index p = mine.begin; p < mine.end; ++p) {
+      chunk += term[std::size_t(p - mine.begin)];
+      if ((p + 1) % kChunk == 0) {
+        total += chunk;
+        chunk = 0;
       }
-    });
+    }
     if (dist.last() && x.rows() % kChunk != 0) total += chunk;
   });
   return state[0];
