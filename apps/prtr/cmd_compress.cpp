@@ -151,6 +151,7 @@ void mpi_compress(const Options& o, const cpca::CompressOptions& options) {
     throw UsageError(
         "mpirun prtr compress runs --method lbg with --alpha 0 and no "
         "--overdraw-reduction; run other methods in one process");
+  const MpiCoreShare cores;
   const std::unique_ptr<cpca::Distribution> dist = mpi_distribution();
   const bool root = dist->first();
   try {

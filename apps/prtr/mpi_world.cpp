@@ -1,5 +1,6 @@
 #include "mpi_world.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +13,16 @@
 #endif
 
 namespace prtr_app {
+
+MpiCoreShare::MpiCoreShare() {
+  const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+  const int ranks = local ? std::atoi(local) : 1;
+  if (ranks <= 1) return;
+  const int cores = std::max(1, int(std::thread::hardware_concurrency()));
+  control_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                   std::size_t(std::max(1, cores / ranks)));
+}
+MpiCoreShare::~MpiCoreShare() = default;
 
 #ifdef PRTR_HAVE_MPI
 
