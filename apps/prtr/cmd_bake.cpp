@@ -43,7 +43,7 @@ prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
     throw UsageError(
         "--shard needs --bounces 0: an interreflection pass reads every vertex's "
         "previous pass, so bake bounces in one process (it streams, so memory "
-        "stays bounded)");
+        "stays bounded) or under mpirun");
   }
   ProgressBar bar(quiet);
   options.progress = [&bar](const prt::BakeProgress& p) {
