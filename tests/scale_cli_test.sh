@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The scale paths of the prtr binary against the one-process results, byte for byte:
 #   blocks  prtr compress out of core with tiny blocks equals the default block size.
-#   mpi     mpirun -np 2 and -np 3 (oversubscribed, localhost only) prtr bake equal the
-#           one-process bake; a failing rank fails the job and leaves no output. Exit 77
+#   mpi     mpirun -np 2 and -np 3 (oversubscribed, localhost only) prtr bake (0, 1 and 2
+#           bounces) and prtr compress equal the one-process results byte for byte; a failing
+#           rank fails the job and leaves no output. Exit 77
 #           (skip) when prtr was built without MPI.
 # Usage: scale_cli_test.sh blocks|mpi PRTR TMPDIR [MPIEXEC]
 set -u
@@ -17,9 +18,9 @@ check() {  # check NAME STATUS
 }
 
 # A floor of n x n vertices under a box: occlusion, so the transfer varies across vertices.
-# The blocks test needs several 256-row blocks (n = 30: 904 vertices); the MPI test few.
-n=6
-[[ $mode == blocks ]] && n=30
+# Both tests need several 256-row blocks (n = 30: 908 vertices): the blocks test to split the
+# passes, the MPI test to give each of 3 ranks rows of its own (ranks own multiples of 256).
+n=30
 mesh=$tmp/scene.obj
 {
   for ((y = 0; y < n; ++y)); do for ((x = 0; x < n; ++x)); do
@@ -37,6 +38,7 @@ mesh=$tmp/scene.obj
   echo "f $((b + 3)) $((b + 7)) $((b + 8)) $((b + 4))"; echo "f $((b + 4)) $((b + 8)) $((b + 5)) $((b + 1))"
 } >"$mesh"
 bake=(bake "$mesh" --order 3 --samples 32 --bounces 0 -q)
+bounced=(bake "$mesh" --order 3 --samples 32 -q)  # --bounces given per run
 
 if [[ $mode == blocks ]]; then
   "$prtr" "${bake[@]}" -o "$tmp/one.prtx" >/dev/null; check "bake" $?
@@ -88,4 +90,45 @@ grep -q "rank 1 of 2" "$tmp/fail.log"; check "the failing rank is named" $?
 rmdir "$tmp/fail.prtx.rank1of2.prtshard"
 mpi 2 "${bake[@]}" -o "$tmp/fail.prtx" >"$tmp/rerun.log" 2>&1; check "a rerun succeeds" $?
 cmp "$tmp/one.prtx" "$tmp/fail.prtx"; check "the rerun equals one process" $?
+
+# Bounces: every rank writes its slice of each pass to OUT.pass0/1 and maps the whole pass
+# after a barrier; any block size (37: blocks straddle the 64-vertex hit chunks).
+for bounces in 1 2; do
+  "$prtr" "${bounced[@]}" --bounces $bounces -o "$tmp/one-b$bounces.prtx" >/dev/null
+  check "one-process bake, $bounces bounces" $?
+  if [[ $bounces == 1 ]]; then
+    # Past the 128-byte header (which records the bounces): the payload itself changes.
+    ! cmp -s -i 128 "$tmp/one.prtx" "$tmp/one-b1.prtx"; check "the bounce changes the transfer" $?
+  fi
+  for ranks in 2 3; do
+    out=$tmp/mpi$ranks-b$bounces.prtx
+    mpi "$ranks" "${bounced[@]}" --bounces $bounces --block-vertices 37 -o "$out" \
+      >"$tmp/b$ranks.log" 2>&1
+    check "mpirun -np $ranks bake --bounces $bounces exits 0" $?
+    cmp "$tmp/one-b$bounces.prtx" "$out"; check "mpirun -np $ranks, $bounces bounces, equals one process" $?
+    left=$(ls "$tmp" | grep -c -e prtshard -e '\.pass[01]$')
+    [[ $left == 0 ]]; check "no shards or pass files left after -np $ranks" $?
+  done
+done
+
+# Compression: chained LBG sums and PCA spread over the ranks give the one-process bytes, for
+# any block size (--block-vertices 1: 256-row blocks inside each rank's rows).
+compress=(compress "$tmp/one.prtx" --mesh "$mesh" --clusters 24 --pcs 2 -q)
+"$prtr" "${compress[@]}" -o "$tmp/one.prtc" --json >"$tmp/one.json"; check "one-process compress" $?
+grep -q '"splits":[1-9]' "$tmp/one.json"; check "the compression splits null clusters" $?
+for ranks in 2 3; do
+  for blocks in 0 1; do
+    out=$tmp/mpi$ranks-$blocks.prtc
+    mpi "$ranks" "${compress[@]}" --block-vertices $blocks -o "$out" >"$tmp/c$ranks.log" 2>&1
+    check "mpirun -np $ranks compress --block-vertices $blocks exits 0" $?
+    cmp "$tmp/one.prtc" "$out"; check "mpirun -np $ranks compress equals one process" $?
+  done
+done
+mpi 2 "${compress[@]}" --method iterative -o "$tmp/it.prtc" >"$tmp/it.log" 2>&1
+[[ $? == 2 ]]; check "mpirun compress refuses --method iterative (exit 2)" $?
+grep -q "method lbg" "$tmp/it.log"; check "the refusal says what runs" $?
+mkdir -p "$tmp/dir.prtc"
+mpi 2 "${compress[@]}" -o "$tmp/dir.prtc" >"$tmp/cfail.log" 2>&1
+[[ $? != 0 ]]; check "a compress whose rank 0 cannot write fails the job" $?
+grep -q "rank 0 of 2" "$tmp/cfail.log"; check "the failing compress rank is named" $?
 exit $((failed > 0))

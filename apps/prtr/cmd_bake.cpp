@@ -33,22 +33,27 @@ std::pair<std::uint32_t, std::uint32_t> parse_shard(const std::string& text) {
 }
 
 // The bake with a progress bar; memory is bounded by the block, so no estimate is checked.
+// `mpi_prefix` (under mpirun with bounces) makes the shard one rank of a bake whose passes
+// all ranks share through files beside the output.
 prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
                              const std::string& output, std::uint64_t block,
                              std::pair<std::uint32_t, std::uint32_t> shard, bool quiet,
-                             prt::BakeStats* stats) {
-  if (shard.second > 0 && options.bounces > 0) {
+                             prt::BakeStats* stats, const std::string& mpi_prefix = {}) {
+  if (shard.second > 0 && options.bounces > 0 && mpi_prefix.empty()) {
     throw UsageError(
         "--shard needs --bounces 0: an interreflection pass reads every vertex's "
         "previous pass, so bake bounces in one process (it streams, so memory "
-        "stays bounded)");
+        "stays bounded) or under mpirun");
   }
   ProgressBar bar(quiet);
   options.progress = [&bar](const prt::BakeProgress& p) {
     bar.update(p.pass == 0 ? "shadow pass" : "bounce " + std::to_string(p.pass), p.done, p.total);
   };
   prt::TransferSet set =
-      shard.second > 0
+      !mpi_prefix.empty()
+          ? prt::bake_rank_with_bounces(mesh, options, output, mpi_prefix, shard.first,
+                                        shard.second, mpi_barrier, block, stats)
+      : shard.second > 0
           ? prt::bake_shard_to_file(mesh, options, output, shard.first, shard.second, block, stats)
           : prt::bake_to_file(mesh, options, output, block, stats);
   bar.finish();
@@ -57,15 +62,14 @@ prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
 
 // Under mpirun: rank r bakes shard r of R beside the output, and once every rank has
 // committed its shard rank 0 merges them into the output (atomically, prt::merge_shards)
-// and deletes them. A rank that fails aborts the whole job before the merge, so nothing
-// appears at the output; a rerun overwrites any shards left behind.
+// and deletes them. With bounces, every pass goes through OUT.pass0/.pass1, which each rank
+// writes its slice of and maps whole after a barrier (prt::bake_rank_with_bounces). A rank
+// that fails aborts the whole job before the merge, so nothing appears at the output; a
+// rerun overwrites any shards and pass files left behind.
 prt::TransferSet mpi_bake(const meshes::Mesh& mesh, const prt::BakeOptions& options,
                           const std::string& output, std::uint64_t block, bool quiet,
                           prt::BakeStats* stats, MpiWorld world) {
-  if (options.bounces > 0)
-    throw UsageError(
-        "mpirun prtr bake needs --bounces 0: interreflection passes under MPI are not built "
-        "yet; bake bounces in one process (it streams, so memory stays bounded)");
+  const std::string passes = options.bounces > 0 ? output : std::string();
   std::vector<std::filesystem::path> shards;
   for (int r = 0; r < world.size; ++r)
     shards.emplace_back(output + ".rank" + std::to_string(r) + "of" + std::to_string(world.size) +
@@ -74,7 +78,7 @@ prt::TransferSet mpi_bake(const meshes::Mesh& mesh, const prt::BakeOptions& opti
   try {
     set = stream_bake(mesh, options, shards[std::size_t(world.rank)].string(), block,
                       {std::uint32_t(world.rank), std::uint32_t(world.size)},
-                      quiet || world.rank != 0, stats);
+                      quiet || world.rank != 0, stats, passes);
   } catch (const std::exception& e) {
     mpi_abort(std::string("bake of its shard failed: ") + e.what());
   }
@@ -83,6 +87,8 @@ prt::TransferSet mpi_bake(const meshes::Mesh& mesh, const prt::BakeOptions& opti
     try {
       prt::merge_shards(shards, output);
       for (const auto& shard : shards) std::filesystem::remove(shard);
+      if (!passes.empty())
+        for (const char* pass : {".pass0", ".pass1"}) std::filesystem::remove(passes + pass);
     } catch (const std::exception& e) {
       mpi_abort(std::string("merge failed: ") + e.what());
     }

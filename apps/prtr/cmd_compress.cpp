@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "compress_flags.h"
 #include "json_output.h"
+#include "mpi_world.h"
 
 #include "cpca/compress.h"
 #include "cpca/compressed_file.h"
@@ -118,6 +119,59 @@ void print_text(const Options& o, const cpca::CompressedSet& set,
               (unsigned long long)s.multi());
 }
 
+void print_report(const Options& o, const cpca::CompressedSet& set,
+                  const cpca::CompressReport& report, const prt::TransferSet& transfer,
+                  const meshes::Mesh& mesh) {
+  const Sizes sizes{double(transfer.vertex_count) * double(transfer.floats_per_vertex()) * 4.0,
+                    double(std::filesystem::file_size(o.output)), double(mesh.triangle_count())};
+  if (o.json)
+    print_json(set, report, sizes);
+  else
+    print_text(o, set, report, sizes);
+}
+
+// The mapped payload as rows in blocks, each block's pages released after a pass.
+cpca::RowBlocks row_blocks(const prt::MappedTransfer& mapped, std::uint64_t block_vertices) {
+  const prt::TransferSet& transfer = mapped.header();
+  const Eigen::Map<const cpca::DataMatrix> rows(mapped.payload(),
+                                                Eigen::Index(transfer.vertex_count),
+                                                Eigen::Index(transfer.floats_per_vertex()));
+  return cpca::RowBlocks(rows, block_rows(transfer, block_vertices),
+                         [&mapped](Eigen::Index first, Eigen::Index count) {
+                           mapped.release(std::uint64_t(first), std::uint64_t(count));
+                         });
+}
+
+// Under mpirun: every rank maps the .prtx and runs its share of LBG and the PCA
+// (cpca/distribution.h); rank 0 writes the file (atomically) and the report. A rank that
+// fails ends the job, so nothing appears at the output.
+void mpi_compress(const Options& o, const cpca::CompressOptions& options) {
+  if (options.method != cpca::ClusterMethod::kLbg || options.alpha > 0 ||
+      options.overdraw_reduction)
+    throw UsageError(
+        "mpirun prtr compress runs --method lbg with --alpha 0 and no "
+        "--overdraw-reduction; run other methods in one process");
+  const MpiCoreShare cores;
+  const std::unique_ptr<cpca::Distribution> dist = mpi_distribution();
+  const bool root = dist->first();
+  try {
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    const prt::MappedTransfer mapped(o.transfer);
+    const prt::TransferSet& transfer = mapped.header();
+    const cpca::RowBlocks blocks = row_blocks(mapped, o.block_vertices);
+    cpca::CompressReport report;
+    const cpca::CompressedSet set = run_compress(transfer, blocks, mesh, o.mesh, options,
+                                                 o.quiet || o.json || !root, &report, dist.get());
+    if (root) {
+      cpca::write_compressed(o.output, set);
+      print_report(o, set, report, transfer, mesh);
+    }
+  } catch (const std::exception& e) {
+    mpi_abort(std::string("compress failed: ") + e.what());
+  }
+  mpi_barrier();
+}
+
 }  // namespace
 
 Runner add_compress_command(CLI::App& app) {
@@ -140,26 +194,16 @@ Runner add_compress_command(CLI::App& app) {
     const Options& o = *opt;
     const cpca::CompressOptions options = resolve_compress_flags(o.compress);
     check_sizes(options, o);
+    if (mpi_world().size > 1) return mpi_compress(o, options);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     const prt::MappedTransfer mapped(o.transfer);
     const prt::TransferSet& transfer = mapped.header();
-    const Eigen::Map<const cpca::DataMatrix> rows(mapped.payload(),
-                                                  Eigen::Index(transfer.vertex_count),
-                                                  Eigen::Index(transfer.floats_per_vertex()));
-    const cpca::RowBlocks blocks(rows, block_rows(transfer, o.block_vertices),
-                                 [&mapped](Eigen::Index first, Eigen::Index count) {
-                                   mapped.release(std::uint64_t(first), std::uint64_t(count));
-                                 });
+    const cpca::RowBlocks blocks = row_blocks(mapped, o.block_vertices);
     cpca::CompressReport report;
     const cpca::CompressedSet set =
         run_compress(transfer, blocks, mesh, o.mesh, options, o.quiet || o.json, &report);
     cpca::write_compressed(o.output, set);
-    const Sizes sizes{double(transfer.vertex_count) * double(transfer.floats_per_vertex()) * 4.0,
-                      double(std::filesystem::file_size(o.output)), double(mesh.triangle_count())};
-    if (o.json)
-      print_json(set, report, sizes);
-    else
-      print_text(o, set, report, sizes);
+    print_report(o, set, report, transfer, mesh);
   };
 }
 

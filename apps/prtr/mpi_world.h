@@ -4,6 +4,11 @@
 // the world is one rank and every call below is a no-op, so the commands need no #ifdefs.
 #pragma once
 
+#include "cpca/distribution.h"
+
+#include <tbb/global_control.h>
+
+#include <memory>
 #include <string>
 
 namespace prtr_app {
@@ -19,6 +24,25 @@ bool mpi_built();
 void mpi_barrier();
 // The smallest `value` over all ranks.
 int mpi_min(int value);
+// The world as a cpca::Distribution, for a compression spread over the ranks. Its
+// exchanges poll with short sleeps, like mpi_barrier, so a waiting rank leaves its core to
+// the ranks still computing. Throws std::runtime_error without MPI.
+std::unique_ptr<cpca::Distribution> mpi_distribution();
+
+// Caps this process's TBB threads at its share of the node's cores (the cores over the ranks
+// mpirun started on this node) while it lives: ranks that each start a thread per core
+// oversubscribe the node and spin against each other. A no-op outside mpirun.
+class MpiCoreShare {
+ public:
+  MpiCoreShare();
+  ~MpiCoreShare();
+  MpiCoreShare(const MpiCoreShare&) = delete;
+  MpiCoreShare& operator=(const MpiCoreShare&) = delete;
+
+ private:
+  std::unique_ptr<tbb::global_control> control_;
+};
+
 // Prints "rank R: message" to stderr and ends the whole job with exit status 1, so that no
 // rank waits forever for one that failed.
 [[noreturn]] void mpi_abort(const std::string& message);

@@ -64,7 +64,7 @@ cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes:
 cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const cpca::RowBlocks& data,
                                  const meshes::Mesh& mesh, const std::string& mesh_path,
                                  cpca::CompressOptions options, bool quiet,
-                                 cpca::CompressReport* report) {
+                                 cpca::CompressReport* report, cpca::Distribution* distribution) {
   if (meshes::content_hash(mesh) != transfer.mesh_hash ||
       mesh.vertex_count() != transfer.vertex_count)
     throw std::runtime_error("the transfer was not baked from " + mesh_path +
@@ -77,14 +77,16 @@ cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const cpca::R
   options.layout = {transfer.order, transfer.channels, transfer.columns()};
   const cpca::Geometry geometry = geometry_of(mesh);
   ProgressBar bar(quiet);
-  cpca::CompressedSet set =
-      cpca::compress(data, options, &geometry, report, [&](const std::string& stage, double f) {
+  cpca::CompressedSet set = cpca::compress(
+      data, options, &geometry, report,
+      [&](const std::string& stage, double f) {
         bar.update(stage == "lbg"    ? "LBG clustering"
                    : stage == "pca"  ? "PCA per cluster"
                    : stage == "cpca" ? "iterative CPCA"
                                      : "overdraw reduction",
                    std::uint64_t(f * 1000), 1000);
-      });
+      },
+      distribution);
   bar.finish();
   set.mesh_hash = transfer.mesh_hash;
   set.transfer_hash = transfer.payload_checksum;

@@ -38,11 +38,13 @@ cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const meshes:
                                  const std::string& mesh_path, cpca::CompressOptions options,
                                  bool quiet, cpca::CompressReport* report = nullptr);
 // The same over rows visited in blocks (an out-of-core .prtx, prt/mapped_transfer.h):
-// `transfer` gives the header fields, its data is not used.
+// `transfer` gives the header fields, its data is not used. With a `distribution`, every
+// rank calls this and rank 0 gets the set (cpca/compress.h).
 cpca::CompressedSet run_compress(const prt::TransferSet& transfer, const cpca::RowBlocks& data,
                                  const meshes::Mesh& mesh, const std::string& mesh_path,
                                  cpca::CompressOptions options, bool quiet,
-                                 cpca::CompressReport* report = nullptr);
+                                 cpca::CompressReport* report = nullptr,
+                                 cpca::Distribution* distribution = nullptr);
 
 std::filesystem::path default_cache_dir();
 

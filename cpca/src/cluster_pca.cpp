@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <numeric>
@@ -18,8 +19,8 @@ namespace {
 // source can drop the pages the gather touched.
 std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                  PcaSolver solver, const PowerIterationOptions& power,
-                                 ClusterPcaStats* stats,
-                                 const std::function<void()>& after_cluster) {
+                                 ClusterPcaStats* stats, const std::function<void()>& after_cluster,
+                                 const std::function<bool(int)>& fits = {}) {
   const int k = set.cluster_count, n = set.component_count;
   const Eigen::Index d = x.cols();
   set.vertex_count = std::uint64_t(x.rows());
@@ -39,7 +40,7 @@ std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, Compress
   tbb::parallel_for(0, k, [&](int o) {
     const int c = order[std::size_t(o)];
     const auto& m = members[std::size_t(c)];
-    if (m.empty()) return;
+    if (m.empty() || (fits && !fits(c))) return;
     const Eigen::Index rows = Eigen::Index(m.size());
     Eigen::MatrixXd f(rows, d);
     for (Eigen::Index i = 0; i < rows; ++i) f.row(i) = x.row(m[std::size_t(i)]).cast<double>();
@@ -90,6 +91,105 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
 std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
                                     const PowerIterationOptions& power, ClusterPcaStats* stats) {
   return fit_clusters(x.all(), set, solver, power, stats, [&x] { x.release_all(); });
+}
+
+namespace {
+
+// What rank `rank` of `ranks` fitted, in the order both sides walk it: for each of its
+// clusters (c = rank, rank + ranks, ...) the mean, the basis and its members' weights as
+// floats, and its members' errors as doubles.
+struct ClusterShare {
+  std::vector<float> floats;
+  std::vector<double> errors;
+};
+
+template <class F>
+void walk_share(const CompressedSet& set, const std::vector<std::vector<std::uint32_t>>& members,
+                int rank, int ranks, F&& visit) {
+  const std::size_t n = std::size_t(set.component_count), d = set.dimension();
+  for (int c = rank; c < set.cluster_count; c += ranks) {
+    if (members[std::size_t(c)].empty()) continue;
+    visit(std::size_t(c) * d, d, std::size_t(c) * n * d, n * d, members[std::size_t(c)]);
+  }
+}
+
+ClusterShare pack_share(const CompressedSet& set, const std::vector<double>& error,
+                        const std::vector<std::vector<std::uint32_t>>& members, int rank,
+                        int ranks) {
+  ClusterShare out;
+  const std::size_t n = std::size_t(set.component_count);
+  walk_share(set, members, rank, ranks,
+             [&](std::size_t mean, std::size_t d, std::size_t basis, std::size_t nd,
+                 const std::vector<std::uint32_t>& m) {
+               auto add = [&](const float* p, std::size_t count) {
+                 out.floats.insert(out.floats.end(), p, p + count);
+               };
+               add(set.means.data() + mean, d);
+               add(set.bases.data() + basis, nd);
+               for (std::uint32_t p : m) {
+                 add(set.weights.data() + std::size_t(p) * n, n);
+                 out.errors.push_back(error[p]);
+               }
+             });
+  return out;
+}
+
+void unpack_share(CompressedSet& set, std::vector<double>& error, const float* floats,
+                  const double* errors, const std::vector<std::vector<std::uint32_t>>& members,
+                  int rank, int ranks) {
+  const std::size_t n = std::size_t(set.component_count);
+  walk_share(set, members, rank, ranks,
+             [&](std::size_t mean, std::size_t d, std::size_t basis, std::size_t nd,
+                 const std::vector<std::uint32_t>& m) {
+               auto take = [&](float* to, std::size_t count) {
+                 std::copy(floats, floats + count, to);
+                 floats += count;
+               };
+               take(set.means.data() + mean, d);
+               take(set.bases.data() + basis, nd);
+               for (std::uint32_t p : m) {
+                 take(set.weights.data() + std::size_t(p) * n, n);
+                 error[p] = *errors++;
+               }
+             });
+}
+
+}  // namespace
+
+std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
+                                    const PowerIterationOptions& power, ClusterPcaStats* stats,
+                                    Distribution& dist) {
+  const int rank = dist.rank(), ranks = dist.size();
+  ClusterPcaStats own;
+  std::vector<double> error = fit_clusters(
+      x.all(), set, solver, power, &own, [&x] { x.release_all(); },
+      [&](int c) { return c % ranks == rank; });
+  if (ranks > 1) {
+    // Every rank holds the same ids, so rank 0 knows the layout of every share.
+    const auto members = cluster_members(set.cluster_of, set.cluster_count);
+    ClusterShare share = pack_share(set, error, members, rank, ranks);
+    share.errors.push_back(double(own.power_iterations));
+    const auto floats = dist.gather(share.floats.data(), share.floats.size() * sizeof(float), 0);
+    const auto errors = dist.gather(share.errors.data(), share.errors.size() * sizeof(double), 0);
+    if (dist.first()) {
+      std::vector<float> f(floats.size() / sizeof(float));
+      std::vector<double> e(errors.size() / sizeof(double));
+      std::memcpy(f.data(), floats.data(), floats.size());
+      std::memcpy(e.data(), errors.data(), errors.size());
+      const float* fp = f.data();
+      const double* ep = e.data();
+      own.power_iterations = 0;
+      for (int r = 0; r < ranks; ++r) {
+        const ClusterShare sizes = pack_share(set, error, members, r, ranks);
+        unpack_share(set, error, fp, ep, members, r, ranks);
+        fp += sizes.floats.size();
+        ep += sizes.errors.size();
+        own.power_iterations += int(*ep++);
+      }
+    }
+  }
+  if (stats) *stats = own;
+  return error;
 }
 
 DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,

@@ -114,19 +114,30 @@ using Notify = std::function<void(const char*, double)>;
 
 // Stage 1, LBG. Progress: log of the converged ratio against log of the threshold.
 LbgResult run_lbg(const RowBlocks& data, const CompressOptions& options,
-                  GeometryCoherence* coherence, const Notify& notify) {
+                  GeometryCoherence* coherence, Distribution& dist, const Notify& notify) {
   LbgOptions lbg_options;
   lbg_options.clusters = options.clusters;
   lbg_options.threshold = options.lbg_threshold;
   lbg_options.max_iterations = options.lbg_max_iterations;
   lbg_options.seed = options.seed;
   notify("lbg", 0);
-  return lbg(data, lbg_options, coherence, [&](int it, double, double ratio) {
+  const LbgCallback progress = [&](int it, double, double ratio) {
     const double by_ratio = ratio > 0 && options.lbg_threshold > 0
                                 ? std::log(ratio) / std::log(options.lbg_threshold)
                                 : 1.0;
     notify("lbg", std::max(by_ratio, double(it) / options.lbg_max_iterations));
-  });
+  };
+  return dist.size() > 1 ? lbg(data, lbg_options, dist, progress)
+                         : lbg(data, lbg_options, coherence, progress);
+}
+
+// Distributed, only the streaming stages run: iterative CPCA, coherence and the overdraw
+// reduction compare every point with many clusters (V x K) and have no chained form.
+void check_distributed(const CompressOptions& o, const Distribution& dist) {
+  if (dist.size() > 1 && (o.method != ClusterMethod::kLbg || o.alpha > 0 || o.overdraw_reduction))
+    throw std::invalid_argument(
+        "a distributed compression runs LBG only (no iterative CPCA, alpha or overdraw "
+        "reduction): run those in one process");
 }
 
 CompressedSet new_set(const CompressOptions& options, const DataLayout& layout,
@@ -208,7 +219,10 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
 
 CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
                        const Geometry* geometry, CompressReport* report,
-                       const CompressProgress& progress) {
+                       const CompressProgress& progress, Distribution* distribution) {
+  SingleProcess one;
+  Distribution& dist = distribution ? *distribution : one;
+  check_distributed(options, dist);
   check(data, options, geometry);
   if (options.method == ClusterMethod::kPatchFirst || options.method == ClusterMethod::kJoint ||
       options.method == ClusterMethod::kPatchJoint) {
@@ -230,7 +244,7 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
   if (options.alpha > 0)
     coherence =
         std::make_unique<GeometryCoherence>(*geometry, std::size_t(data.rows()), options.alpha);
-  LbgResult clustering = run_lbg(data, options, coherence.get(), notify);
+  LbgResult clustering = run_lbg(data, options, coherence.get(), dist, notify);
   r.lbg_seconds = seconds_since(t);
   r.lbg_iterations = clustering.iterations;
   r.splits = clustering.splits;
@@ -244,10 +258,13 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
   PowerIterationOptions power;
   power.seed = options.seed;
   ClusterPcaStats stats;
-  std::vector<double> vertex_error = fit_cluster_pca(data, set, options.solver, power, &stats);
+  std::vector<double> vertex_error =
+      dist.size() > 1 ? fit_cluster_pca(data, set, options.solver, power, &stats, dist)
+                      : fit_cluster_pca(data, set, options.solver, power, &stats);
   r.power_iterations += stats.power_iterations;
   r.pca_seconds = seconds_since(t);
   notify("pca", 1);
+  if (!dist.first()) return set;  // rank 0 holds the whole set
 
   int iterations = clustering.iterations;
   if (options.method == ClusterMethod::kIterative) {

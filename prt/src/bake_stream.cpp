@@ -10,9 +10,11 @@
 #include "prt/transfer_shard.h"
 
 #include <algorithm>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <fcntl.h>
@@ -134,7 +136,116 @@ void stream_bounces(detail::BakeEngine& engine, int bounces, std::uint64_t block
   }
 }
 
+// A pass of every vertex in one file beside the output, which each rank of a distributed
+// bake writes its slice of and then maps whole. Not an AtomicFile: every rank opens the
+// same path. Reused across runs, since each run rewrites every byte it reads.
+class SharedPass {
+ public:
+  explicit SharedPass(fs::path path) : path_(std::move(path)) {
+    fd_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw common::IoError(path_.string() + ": cannot open the shared pass file");
+  }
+  ~SharedPass() { ::close(fd_); }
+  SharedPass(const SharedPass&) = delete;
+  SharedPass& operator=(const SharedPass&) = delete;
+
+  void write(const float* data, std::size_t floats, std::uint64_t first_float) {
+    const auto* p = reinterpret_cast<const char*>(data);
+    std::size_t left = floats * sizeof(float);
+    off_t at = off_t(first_float * sizeof(float));
+    while (left > 0) {
+      const ssize_t n = ::pwrite(fd_, p, left, at);
+      if (n <= 0) throw common::IoError(path_.string() + ": cannot write (disk full?)");
+      p += n;
+      at += n;
+      left -= std::size_t(n);
+    }
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+};
+
+// The shadow pass of one rank's range: M^0 to the shared pass, S^0 = M^0 and the hits to
+// the rank's own scratch files.
+void rank_shadow(detail::BakeEngine& engine, const ShardRange& range, std::uint64_t block,
+                 SharedPass& pass, Scratch& sum, HitStore& hits) {
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  std::vector<float> buffer(std::min(range.end - range.first, block) * per_vertex);
+  std::vector<HitBlock> hit_blocks;
+  engine.start_pass(0);
+  for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
+    const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
+    engine.shadow(begin, end, buffer.data(), &hit_blocks);
+    pass.write(buffer.data(), n, begin * per_vertex);
+    sum.write(buffer.data(), n * sizeof(float));
+    hits.store(hit_blocks);
+  }
+  engine.finish_pass();
+}
+
 }  // namespace
+
+TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& o,
+                                   const fs::path& path, const fs::path& shared_prefix,
+                                   std::uint32_t index, std::uint32_t count,
+                                   const std::function<void()>& barrier,
+                                   std::uint64_t block_vertices, BakeStats* stats) {
+  BakeStats local_stats;
+  detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
+  const TransferSet shape = engine.shape();
+  const std::uint64_t v = engine.vertex_count();
+  const ShardRange range = shard_range(v, index, count);
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::uint64_t block = std::max<std::uint64_t>(
+      1, std::min(range.end - range.first,
+                  block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex)));
+  TransferShardWriter writer(path, shape, range);
+  SharedPass passes[2] = {SharedPass(shared_prefix.string() + ".pass0"),
+                          SharedPass(shared_prefix.string() + ".pass1")};
+  HitStore hits(scratch_target(path, "hits"));
+  auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
+  rank_shadow(engine, range, block, passes[0], *running, hits);
+  barrier();  // every rank's M^0 is in passes[0]
+  std::vector<float> current(block * per_vertex), sum(block * per_vertex);
+  std::vector<HitBlock> hit_blocks;
+  const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
+  for (int b = 1; b <= o.bounces; ++b) {
+    const bool last = b == o.bounces;
+    auto next_running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
+    const common::MappedFile map(passes[(b - 1) % 2].path());
+    if (map.size() < v * per_vertex * sizeof(float))
+      throw common::IoError(passes[(b - 1) % 2].path().string() +
+                            ": shorter than a pass; is the output directory shared by all ranks?");
+    engine.start_pass(b);
+    for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
+      const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
+      const std::uint64_t local = begin - range.first;
+      hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
+      engine.bounce(begin, end, hit_blocks, reinterpret_cast<const float*>(map.data()),
+                    current.data());
+      running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
+      for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
+      if (last) {
+        writer.append(sum.data(), n);
+      } else {
+        passes[b % 2].write(current.data(), n, begin * per_vertex);
+        next_running->write(sum.data(), n * sizeof(float));
+      }
+      map.release();
+    }
+    engine.finish_pass();
+    running = next_running;
+    // Every rank's M^b is written, and nobody reads M^(b-1) any more, whose file pass b + 1
+    // overwrites.
+    if (!last) barrier();
+  }
+  writer.commit();
+  engine.finish();
+  return shape;
+}
 
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex) {
   // ~64 MiB of transfer per block buffer: large enough that a block keeps every thread busy

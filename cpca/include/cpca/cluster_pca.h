@@ -6,6 +6,7 @@
 #pragma once
 
 #include "cpca/compressed.h"
+#include "cpca/distribution.h"
 #include "cpca/metrics.h"
 #include "cpca/power_iteration.h"
 #include "cpca/row_blocks.h"
@@ -31,6 +32,14 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
 std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
                                     const PowerIterationOptions& power = {},
                                     ClusterPcaStats* stats = nullptr);
+
+// The same spread over ranks: rank r fits clusters r, r + R, ... (every rank holds all ids
+// and maps all rows, so each gathers its clusters itself), then rank 0 gathers the means,
+// bases, weights and errors of the others. The set and errors are complete on rank 0 only.
+// Bit-identical to the calls above: each cluster is fitted by the same code on the same rows.
+std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
+                                    const PowerIterationOptions& power, ClusterPcaStats* stats,
+                                    Distribution& distribution);
 
 // V x K: ||x_p - m_k||^2 - ||B_k (x_p - m_k)||^2 for every point and cluster, i.e. the squared
 // distance from x_p to cluster k's affine subspace (bases orthonormal). Computed as two matrix

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "cpca/compressed.h"
+#include "cpca/distribution.h"
 #include "cpca/geometry.h"
 #include "cpca/lbg.h"
 #include "cpca/metrics.h"
@@ -90,9 +91,13 @@ CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressO
 // blocks (lbg.h, cluster_pca.h), so with LBG and alpha 0 memory holds one block, the
 // centroids and the clusters being fitted; geometry coherence, iterative CPCA and the
 // overdraw reduction still need V x K matrices. Bit-identical to the call above.
+// With a `distribution` of several ranks (LBG, alpha 0, no overdraw reduction; else
+// std::invalid_argument) every rank calls this; LBG and the PCA are spread over them
+// (lbg.h, cluster_pca.h) and rank 0 returns the whole set and report, bit-identical to one
+// process; the other ranks return an incomplete set to be discarded.
 CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
                        const Geometry* geometry = nullptr, CompressReport* report = nullptr,
-                       const CompressProgress& progress = {});
+                       const CompressProgress& progress = {}, Distribution* distribution = nullptr);
 
 // Average SE, relative and max error of a set against its data, by reconstructing every row
 // (a code path independent of the compressor's own bookkeeping).

@@ -13,6 +13,7 @@
 #pragma once
 
 #include "cpca/assignment.h"
+#include "cpca/distribution.h"
 #include "cpca/metrics.h"
 #include "cpca/row_blocks.h"
 
@@ -50,6 +51,12 @@ LbgResult lbg(const Eigen::Ref<const DataMatrix>& x, const LbgOptions& options,
 LbgResult lbg(const RowBlocks& x, const LbgOptions& options,
               const GeometryCoherence* coherence = nullptr, const LbgCallback& callback = {});
 
+// The same spread over the ranks of `distribution` (no geometry coherence): each rank
+// assigns its rank_rows; the centroid sums, energy and hyper box are chained
+// (distribution.h), so every rank returns the result of the one-process call bit for bit.
+LbgResult lbg(const RowBlocks& x, const LbgOptions& options, Distribution& distribution,
+              const LbgCallback& callback = {});
+
 // Fills every empty cluster (ids < cluster_count) by splitting the most populated one along
 // its principal direction. Returns the number of splits. Throws std::invalid_argument when
 // there are more clusters than points.
@@ -70,6 +77,13 @@ double clustering_energy(const Eigen::Ref<const DataMatrix>& x,
                          const std::vector<std::uint32_t>& cluster_of, const DataMatrix& means);
 double clustering_energy(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
                          const DataMatrix& means);
+
+// The same two spread over ranks (each its rank_rows, chained), equal to the calls above bit
+// for bit on every rank. `cluster_of` holds every row's id on every rank.
+DataMatrix cluster_means(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
+                         int cluster_count, Distribution& distribution);
+double clustering_energy(const RowBlocks& x, const std::vector<std::uint32_t>& cluster_of,
+                         const DataMatrix& means, Distribution& distribution);
 
 // Members of each cluster, ascending.
 std::vector<std::vector<std::uint32_t>> cluster_members(

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <functional>
 
 namespace cpca {
@@ -48,6 +49,17 @@ class RowBlocks {
     for (Eigen::Index b = 0; b < block_count(); ++b) {
       f(block_begin(b), block(b));
       release(block_begin(b), block_size(b));
+    }
+  }
+  // The same over rows [begin, end) only (one rank's rows, distribution.h), in blocks of
+  // block_rows() from `begin`: with `begin` on a multiple of kGranule every block boundary
+  // still falls on one.
+  template <class F>
+  void for_each_in(Eigen::Index begin, Eigen::Index end, F&& f) const {
+    for (Eigen::Index first = begin; first < end; first += block_rows_) {
+      const Eigen::Index n = std::min(block_rows_, end - first);
+      f(first, view_.middleRows(first, n));
+      release(first, n);
     }
   }
 

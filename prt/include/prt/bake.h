@@ -123,6 +123,19 @@ TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& opti
                                std::uint32_t count, std::uint64_t block_vertices = 0,
                                BakeStats* stats = nullptr);
 
+// Rank `index` of `count` processes that bake one bake with bounces together (mpirun):
+// each computes every pass for its shard range, writes the pass into the shared file
+// `shared_prefix`.pass0 or .pass1 (alternating; every rank must see the same file) and calls
+// `barrier`, which returns once every rank has called it; pass b + 1 then maps the whole
+// pass b. The last pass's sums go to the shard at `path`, as bake_shard_to_file writes it,
+// so the shards merge into the one-process bake's bytes. The caller removes the shared
+// files after the last barrier. docs/ARCHITECTURE.md, "Scale".
+TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& options,
+                                   const std::filesystem::path& path,
+                                   const std::filesystem::path& shared_prefix, std::uint32_t index,
+                                   std::uint32_t count, const std::function<void()>& barrier,
+                                   std::uint64_t block_vertices = 0, BakeStats* stats = nullptr);
+
 // Vertices per block holding about 64 MiB of transfer (a multiple of 64, at least 64).
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex);
 
