@@ -4,6 +4,8 @@
 // the order grouping's.
 #include "cpca/joint_search.h"
 
+#include "cpca/cluster_pca.h"
+
 #include "cpca/supercluster_strategy.h"
 #include "cpca_test_support.h"
 
@@ -102,6 +104,26 @@ TEST(JointSearch, ObjectiveNeverRisesAndMatchesARecount) {
           lambda * search.error_scale * double(drawn) / double(g.triangles.size());
       EXPECT_NEAR(search.objective.back(), recount, 1e-5 * recount);
     }
+}
+
+// The search refits only the clusters a step changed: the result must still be what a PCA
+// fit of every cluster of the returned membership gives.
+TEST(JointSearch, PartialRefitsEqualAFullFit) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 7);
+  for (const auto method : {cpca::ClusterMethod::kJoint, cpca::ClusterMethod::kPatchJoint}) {
+    cpca::JointSearchResult search;
+    const cpca::CompressOptions o = options(method, 0.5);
+    const cpca::CompressedSet set = cpca::compress_joint(x, o, g, nullptr, &search);
+    ASSERT_GE(search.steps, 2);  // at least one step refitted from an earlier partial state
+    cpca::CompressedSet full = set;
+    cpca::PowerIterationOptions power;
+    power.seed = o.seed;
+    cpca::fit_cluster_pca(x, full, o.solver, power);
+    EXPECT_EQ(full.means, set.means);
+    EXPECT_EQ(full.bases, set.bases);
+    EXPECT_EQ(full.weights, set.weights);
+  }
 }
 
 TEST(JointSearch, LargerLambdaDrawsFewerTriangles) {

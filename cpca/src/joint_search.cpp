@@ -132,6 +132,49 @@ std::uint64_t swap_descent(const ClusterIncidence& inc, int per_pass,
   return search.drawn();
 }
 
+// PCA refit of the clusters whose membership differs from `before`'s; the others keep their
+// means, bases, weights and errors. A cluster's fit depends only on its member rows in
+// ascending order and the seed (cluster_pca.h), so this equals a refit of every cluster bit
+// for bit, at the cost of the clusters that changed (late steps move few vertices).
+std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
+                                  const CompressedSet& before, const std::vector<double>& error,
+                                  CompressedSet& next, const JointSearchOptions& o) {
+  std::vector<char> changed(std::size_t(next.cluster_count), 0);
+  for (std::size_t p = 0; p < next.cluster_of.size(); ++p)
+    if (next.cluster_of[p] != before.cluster_of[p])
+      changed[before.cluster_of[p]] = changed[next.cluster_of[p]] = 1;
+  std::vector<std::uint32_t> local(changed.size(), ~0u), ids;
+  for (std::uint32_t c = 0; c < changed.size(); ++c)
+    if (changed[c]) local[c] = std::uint32_t(ids.size()), ids.push_back(c);
+  std::vector<double> next_error = error;
+  if (ids.empty()) return next_error;
+  std::vector<std::uint32_t> rows;
+  CompressedSet part;
+  part.cluster_count = int(ids.size());
+  part.component_count = next.component_count;
+  for (std::uint32_t p = 0; p < next.cluster_of.size(); ++p)
+    if (changed[next.cluster_of[p]])
+      rows.push_back(p), part.cluster_of.push_back(local[next.cluster_of[p]]);
+  DataMatrix x(Eigen::Index(rows.size()), data.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) x.row(Eigen::Index(i)) = data.row(rows[i]);
+  PowerIterationOptions power;
+  power.seed = o.seed;
+  const std::vector<double> part_error = fit_cluster_pca(x, part, o.solver, power);
+  const std::size_t d = next.dimension(), n = std::size_t(next.component_count);
+  for (std::size_t j = 0; j < ids.size(); ++j) {
+    std::copy_n(part.means.begin() + std::ptrdiff_t(j * d), d,
+                next.means.begin() + std::ptrdiff_t(ids[j] * d));
+    std::copy_n(part.bases.begin() + std::ptrdiff_t(j * n * d), n * d,
+                next.bases.begin() + std::ptrdiff_t(ids[j] * n * d));
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    next_error[rows[i]] = part_error[i];
+    std::copy_n(part.weights.begin() + std::ptrdiff_t(i * n), n,
+                next.weights.begin() + std::ptrdiff_t(std::size_t(rows[i]) * n));
+  }
+  return next_error;
+}
+
 ClusterIncidence incidence_of(const CompressedSet& set, const Geometry& g, int per_pass) {
   SuperClusterInput input;
   input.cluster_of = set.cluster_of;
@@ -160,9 +203,7 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
     SweepState s{g.triangles, vt, next_pass, next.cluster_of, size, mu};
     drawn -= std::uint64_t(sweep_vertices(data, d2, set, s, moves));
   }
-  PowerIterationOptions power;
-  power.seed = o.seed;
-  std::vector<double> next_error = fit_cluster_pca(data, next, o.solver, power);
+  std::vector<double> next_error = refit_changed(data, set, error, next, o);
   if (mu != 0) {
     const ClusterIncidence inc = incidence_of(next, g, o.per_pass);
     PRTR_DCHECK(triangles_drawn(inc, next_pass) == drawn);
