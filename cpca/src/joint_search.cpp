@@ -49,6 +49,7 @@ struct SweepState {
   std::vector<std::uint32_t>& cluster_of;
   std::vector<std::uint32_t>& size;  // members per cluster
   double mu;                         // weight of one drawn triangle, in squared-error units
+  std::uint64_t drawn, cap;          // triangles drawn now; no move may take them above cap
 
   std::uint32_t pass(std::uint32_t v) const { return pass_of[cluster_of[v]]; }
   // Draws of p's triangles if p's pass were q (a vertex listed twice in a triangle moves
@@ -79,6 +80,7 @@ std::int64_t sweep_vertices(const Eigen::Ref<const DataMatrix>& data, const Data
     std::int64_t best_draws = here;
     const auto consider = [&](std::uint32_t c, double err) {
       const std::int64_t n = s.pass_of[c] == s.pass_of[a] ? here : s.draws(p, s.pass_of[c]);
+      if (n > here && s.drawn + std::uint64_t(n - here) > s.cap) return;
       const double delta = err - double(d2(p, a)) + s.mu * double(n - here);
       if (delta < best) best = delta, best_c = c, best_draws = n;
     };
@@ -98,6 +100,7 @@ std::int64_t sweep_vertices(const Eigen::Ref<const DataMatrix>& data, const Data
     --s.size[a], ++s.size[best_c];
     s.cluster_of[p] = best_c;
     saved += here - best_draws;
+    s.drawn = std::uint64_t(std::int64_t(s.drawn) + best_draws - here);
     ++moves;
   }
   return saved;
@@ -200,7 +203,16 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
   } else {
     std::vector<std::uint32_t> size(std::size_t(set.cluster_count), 0);
     for (std::uint32_t c : set.cluster_of) ++size[c];
-    SweepState s{g.triangles, vt, next_pass, next.cluster_of, size, mu};
+    const double cap = o.overdraw_cap * double(g.triangles.size());
+    SweepState s{g.triangles,
+                 vt,
+                 next_pass,
+                 next.cluster_of,
+                 size,
+                 mu,
+                 drawn,
+                 o.overdraw_cap > 0 ? std::uint64_t(std::floor(cap))
+                                    : std::numeric_limits<std::uint64_t>::max()};
     drawn -= std::uint64_t(sweep_vertices(data, d2, set, s, moves));
   }
   std::vector<double> next_error = refit_changed(data, set, error, next, o);
@@ -314,6 +326,9 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
   if (!(options.lambda >= 0) || !std::isfinite(options.lambda))
     throw std::invalid_argument("joint search: lambda must be finite and >= 0, got " +
                                 std::to_string(options.lambda));
+  if (!(options.overdraw_cap == 0 || options.overdraw_cap >= 1))
+    throw std::invalid_argument("joint search: the overdraw cap must be 0 (none) or >= 1, got " +
+                                std::to_string(options.overdraw_cap));
   JointSearchResult r;
   const double total = sum(vertex_error);
   r.error_scale = total / double(data.rows());
@@ -338,7 +353,8 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
 
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report, JointSearchResult* search) {
+                             CompressReport* report, JointSearchResult* search,
+                             double overdraw_cap) {
   if (options.alpha != 0 || options.overdraw_reduction)
     throw std::invalid_argument(
         "the joint search takes neither geometry coherence (alpha) nor the overdraw reduction: "
@@ -364,6 +380,7 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   jo.candidates = options.cpca_candidates;
   jo.solver = options.solver;
   jo.seed = options.seed;
+  jo.overdraw_cap = overdraw_cap;
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
   set.method = options.method;

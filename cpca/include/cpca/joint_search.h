@@ -37,6 +37,10 @@ struct JointSearchOptions {
   int candidates = 16;      // nearest-mean candidates per vertex (cluster_pca.h)
   PcaSolver solver = PcaSolver::kPowerIteration;
   std::uint64_t seed = 1;
+  // 0, or an average overdraw no vertex move may take the search above (a start above it
+  // may only come down). A constraint, not a weight: with a small lambda the search spends
+  // the overdraw budget on error, and J still never rises.
+  double overdraw_cap = 0.0;
 };
 
 struct JointSearchResult {
@@ -72,6 +76,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
 // report's pca_seconds holds the start's fit, refit and grouping, cpca_seconds the search.
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report = nullptr, JointSearchResult* search = nullptr);
+                             CompressReport* report = nullptr, JointSearchResult* search = nullptr,
+                             double overdraw_cap = 0.0);
 
 }  // namespace cpca
