@@ -4,9 +4,11 @@
 // supercluster_search.h), for patch-first and joint with the passes they were designed for
 // (cpca::designed_passes).
 // Usage: pass_design_bench TRANSFER MESH [K,...] [PER_PASS,...] [ROW,...] [MAX_STEPS]
-//   ROW: original | patch-first | joint:LAMBDA | patch-joint:LAMBDA     (defaults: 64,128,192,256
+//   ROW: original | patch-first | joint:LAMBDA[:CAP] | patch-joint:LAMBDA[:CAP]  (CAP: the
+//   search's overdraw cap, joint_search.h)     (defaults: 64,128,192,256
 //   3,16 original,patch-first,joint:0.5)
 #include "cpca/compress.h"
+#include "cpca/joint_search.h"
 #include "cpca/patch_first.h"
 #include "cpca/supercluster.h"
 #include "cpca/supercluster_strategy.h"
@@ -20,12 +22,15 @@
 
 namespace {
 
-std::vector<std::string> split(const std::string& text) {
+std::vector<std::string> split_on(const std::string& text, char separator) {
   std::vector<std::string> items;
   std::stringstream in(text);
   std::string item;
-  while (std::getline(in, item, ',')) items.push_back(item);
+  while (std::getline(in, item, separator)) items.push_back(item);
   return items;
+}
+std::vector<std::string> split(const std::string& text) {
+  return split_on(text, ',');
 }
 
 struct Row {
@@ -35,6 +40,7 @@ struct Row {
 Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOptions o,
         const std::string& row, int per_pass) {
   o.clusters_per_pass = per_pass;
+  double cap = 0;
   if (row == "original") {
     o.method = cpca::ClusterMethod::kLbg;
   } else if (row == "patch-first") {
@@ -42,10 +48,13 @@ Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOption
   } else {
     o.method = row.rfind("patch-joint", 0) == 0 ? cpca::ClusterMethod::kPatchJoint
                                                 : cpca::ClusterMethod::kJoint;
-    o.lambda = std::stod(row.substr(row.find(':') + 1));
+    const auto fields = split_on(row, ':');
+    o.lambda = std::stod(fields.at(1));
+    if (fields.size() > 2) cap = std::stod(fields[2]);
   }
   cpca::CompressReport report;
-  const cpca::CompressedSet set = cpca::compress(x, o, &g, &report);
+  const cpca::CompressedSet set = cap > 0 ? cpca::compress_joint(x, o, g, &report, nullptr, cap)
+                                          : cpca::compress(x, o, &g, &report);
   Row r;
   r.seconds = report.clustering_seconds() + report.pca_seconds;
   r.se = cpca::error_metrics(x, set).average_squared_error;

@@ -4,6 +4,8 @@
 // the order grouping's.
 #include "cpca/joint_search.h"
 
+#include "cpca/cluster_pca.h"
+
 #include "cpca/supercluster_strategy.h"
 #include "cpca_test_support.h"
 
@@ -104,6 +106,26 @@ TEST(JointSearch, ObjectiveNeverRisesAndMatchesARecount) {
     }
 }
 
+// The search refits only the clusters a step changed: the result must still be what a PCA
+// fit of every cluster of the returned membership gives.
+TEST(JointSearch, PartialRefitsEqualAFullFit) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 7);
+  for (const auto method : {cpca::ClusterMethod::kJoint, cpca::ClusterMethod::kPatchJoint}) {
+    cpca::JointSearchResult search;
+    const cpca::CompressOptions o = options(method, 0.5);
+    const cpca::CompressedSet set = cpca::compress_joint(x, o, g, nullptr, &search);
+    ASSERT_GE(search.steps, 2);  // at least one step refitted from an earlier partial state
+    cpca::CompressedSet full = set;
+    cpca::PowerIterationOptions power;
+    power.seed = o.seed;
+    cpca::fit_cluster_pca(x, full, o.solver, power);
+    EXPECT_EQ(full.means, set.means);
+    EXPECT_EQ(full.bases, set.bases);
+    EXPECT_EQ(full.weights, set.weights);
+  }
+}
+
 TEST(JointSearch, LargerLambdaDrawsFewerTriangles) {
   const cpca::Geometry g = cpca_test::grid(kN);
   const cpca::DataMatrix x = smooth_data(g, 9);
@@ -111,6 +133,33 @@ TEST(JointSearch, LargerLambdaDrawsFewerTriangles) {
   cpca::compress_joint(x, options(cpca::ClusterMethod::kJoint, 0.01), g, nullptr, &low);
   cpca::compress_joint(x, options(cpca::ClusterMethod::kJoint, 10.0), g, nullptr, &high);
   EXPECT_LT(high.triangles_drawn, low.triangles_drawn);
+}
+
+// With a small lambda the search buys error with overdraw; a cap holds the overdraw at or
+// below it (brute-force count) while J still never rises, and the error stays below the
+// start's.
+TEST(JointSearch, OverdrawCapBoundsTheDraws) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 11);
+  const cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchJoint, 0.01);
+  cpca::JointSearchResult free_search;
+  cpca::compress_joint(x, o, g, nullptr, &free_search);
+  const double free_overdraw = double(free_search.triangles_drawn) / double(g.triangles.size());
+  cpca::JointSearchResult first;
+  cpca::compress_joint(x, o, g, nullptr, &first, 1.0);  // the tightest cap there is
+  const double floor_overdraw = double(first.triangles_drawn) / double(g.triangles.size());
+  // A cap halfway between what the capped and the free searches reach must bind.
+  const double cap = 0.5 * (floor_overdraw + free_overdraw);
+  ASSERT_LT(floor_overdraw, cap);
+  cpca::JointSearchResult capped;
+  const cpca::CompressedSet set = cpca::compress_joint(x, o, g, nullptr, &capped, cap);
+  const std::uint64_t drawn = brute_force_draws(set.cluster_of, g.triangles);
+  EXPECT_EQ(capped.triangles_drawn, drawn);
+  EXPECT_LE(double(drawn), cap * double(g.triangles.size()));
+  EXPECT_LT(drawn, free_search.triangles_drawn);
+  for (std::size_t i = 1; i < capped.objective.size(); ++i)
+    EXPECT_LE(capped.objective[i], capped.objective[i - 1]) << "stage " << i;
+  EXPECT_THROW(cpca::compress_joint(x, o, g, nullptr, nullptr, 0.5), std::invalid_argument);
 }
 
 TEST(JointSearch, OrderProfilePutsTheRoomInTheLastPass) {

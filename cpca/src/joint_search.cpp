@@ -49,6 +49,7 @@ struct SweepState {
   std::vector<std::uint32_t>& cluster_of;
   std::vector<std::uint32_t>& size;  // members per cluster
   double mu;                         // weight of one drawn triangle, in squared-error units
+  std::uint64_t drawn, cap;          // triangles drawn now; no move may take them above cap
 
   std::uint32_t pass(std::uint32_t v) const { return pass_of[cluster_of[v]]; }
   // Draws of p's triangles if p's pass were q (a vertex listed twice in a triangle moves
@@ -79,6 +80,7 @@ std::int64_t sweep_vertices(const Eigen::Ref<const DataMatrix>& data, const Data
     std::int64_t best_draws = here;
     const auto consider = [&](std::uint32_t c, double err) {
       const std::int64_t n = s.pass_of[c] == s.pass_of[a] ? here : s.draws(p, s.pass_of[c]);
+      if (n > here && s.drawn + std::uint64_t(n - here) > s.cap) return;
       const double delta = err - double(d2(p, a)) + s.mu * double(n - here);
       if (delta < best) best = delta, best_c = c, best_draws = n;
     };
@@ -98,6 +100,7 @@ std::int64_t sweep_vertices(const Eigen::Ref<const DataMatrix>& data, const Data
     --s.size[a], ++s.size[best_c];
     s.cluster_of[p] = best_c;
     saved += here - best_draws;
+    s.drawn = std::uint64_t(std::int64_t(s.drawn) + best_draws - here);
     ++moves;
   }
   return saved;
@@ -132,6 +135,49 @@ std::uint64_t swap_descent(const ClusterIncidence& inc, int per_pass,
   return search.drawn();
 }
 
+// PCA refit of the clusters whose membership differs from `before`'s; the others keep their
+// means, bases, weights and errors. A cluster's fit depends only on its member rows in
+// ascending order and the seed (cluster_pca.h), so this equals a refit of every cluster bit
+// for bit, at the cost of the clusters that changed (late steps move few vertices).
+std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
+                                  const CompressedSet& before, const std::vector<double>& error,
+                                  CompressedSet& next, const JointSearchOptions& o) {
+  std::vector<char> changed(std::size_t(next.cluster_count), 0);
+  for (std::size_t p = 0; p < next.cluster_of.size(); ++p)
+    if (next.cluster_of[p] != before.cluster_of[p])
+      changed[before.cluster_of[p]] = changed[next.cluster_of[p]] = 1;
+  std::vector<std::uint32_t> local(changed.size(), ~0u), ids;
+  for (std::uint32_t c = 0; c < changed.size(); ++c)
+    if (changed[c]) local[c] = std::uint32_t(ids.size()), ids.push_back(c);
+  std::vector<double> next_error = error;
+  if (ids.empty()) return next_error;
+  std::vector<std::uint32_t> rows;
+  CompressedSet part;
+  part.cluster_count = int(ids.size());
+  part.component_count = next.component_count;
+  for (std::uint32_t p = 0; p < next.cluster_of.size(); ++p)
+    if (changed[next.cluster_of[p]])
+      rows.push_back(p), part.cluster_of.push_back(local[next.cluster_of[p]]);
+  DataMatrix x(Eigen::Index(rows.size()), data.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i) x.row(Eigen::Index(i)) = data.row(rows[i]);
+  PowerIterationOptions power;
+  power.seed = o.seed;
+  const std::vector<double> part_error = fit_cluster_pca(x, part, o.solver, power);
+  const std::size_t d = next.dimension(), n = std::size_t(next.component_count);
+  for (std::size_t j = 0; j < ids.size(); ++j) {
+    std::copy_n(part.means.begin() + std::ptrdiff_t(j * d), d,
+                next.means.begin() + std::ptrdiff_t(ids[j] * d));
+    std::copy_n(part.bases.begin() + std::ptrdiff_t(j * n * d), n * d,
+                next.bases.begin() + std::ptrdiff_t(ids[j] * n * d));
+  }
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    next_error[rows[i]] = part_error[i];
+    std::copy_n(part.weights.begin() + std::ptrdiff_t(i * n), n,
+                next.weights.begin() + std::ptrdiff_t(std::size_t(rows[i]) * n));
+  }
+  return next_error;
+}
+
 ClusterIncidence incidence_of(const CompressedSet& set, const Geometry& g, int per_pass) {
   SuperClusterInput input;
   input.cluster_of = set.cluster_of;
@@ -157,12 +203,19 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
   } else {
     std::vector<std::uint32_t> size(std::size_t(set.cluster_count), 0);
     for (std::uint32_t c : set.cluster_of) ++size[c];
-    SweepState s{g.triangles, vt, next_pass, next.cluster_of, size, mu};
+    const double cap = o.overdraw_cap * double(g.triangles.size());
+    SweepState s{g.triangles,
+                 vt,
+                 next_pass,
+                 next.cluster_of,
+                 size,
+                 mu,
+                 drawn,
+                 o.overdraw_cap > 0 ? std::uint64_t(std::floor(cap))
+                                    : std::numeric_limits<std::uint64_t>::max()};
     drawn -= std::uint64_t(sweep_vertices(data, d2, set, s, moves));
   }
-  PowerIterationOptions power;
-  power.seed = o.seed;
-  std::vector<double> next_error = fit_cluster_pca(data, next, o.solver, power);
+  std::vector<double> next_error = refit_changed(data, set, error, next, o);
   if (mu != 0) {
     const ClusterIncidence inc = incidence_of(next, g, o.per_pass);
     PRTR_DCHECK(triangles_drawn(inc, next_pass) == drawn);
@@ -273,6 +326,9 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
   if (!(options.lambda >= 0) || !std::isfinite(options.lambda))
     throw std::invalid_argument("joint search: lambda must be finite and >= 0, got " +
                                 std::to_string(options.lambda));
+  if (!(options.overdraw_cap == 0 || options.overdraw_cap >= 1))
+    throw std::invalid_argument("joint search: the overdraw cap must be 0 (none) or >= 1, got " +
+                                std::to_string(options.overdraw_cap));
   JointSearchResult r;
   const double total = sum(vertex_error);
   r.error_scale = total / double(data.rows());
@@ -297,7 +353,8 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
 
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report, JointSearchResult* search) {
+                             CompressReport* report, JointSearchResult* search,
+                             double overdraw_cap) {
   if (options.alpha != 0 || options.overdraw_reduction)
     throw std::invalid_argument(
         "the joint search takes neither geometry coherence (alpha) nor the overdraw reduction: "
@@ -323,6 +380,7 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   jo.candidates = options.cpca_candidates;
   jo.solver = options.solver;
   jo.seed = options.seed;
+  jo.overdraw_cap = overdraw_cap;
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
   set.method = options.method;

@@ -37,6 +37,10 @@ struct JointSearchOptions {
   int candidates = 16;      // nearest-mean candidates per vertex (cluster_pca.h)
   PcaSolver solver = PcaSolver::kPowerIteration;
   std::uint64_t seed = 1;
+  // 0, or an average overdraw no vertex move may take the search above (a start above it
+  // may only come down). A constraint, not a weight: with a small lambda the search spends
+  // the overdraw budget on error, and J still never rises.
+  double overdraw_cap = 0.0;
 };
 
 struct JointSearchResult {
@@ -70,8 +74,11 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
 // the search, then clusters renumbered so that pass p holds [p * per_pass, (p + 1) *
 // per_pass) (designed_passes() in patch_first.h). Needs the geometry; alpha must be 0. The
 // report's pca_seconds holds the start's fit, refit and grouping, cpca_seconds the search.
+// overdraw_cap is JointSearchOptions::overdraw_cap (the epsilon-constraint form of the
+// trade-off, Haimes et al. 1971; CompressOptions has no field for it).
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report = nullptr, JointSearchResult* search = nullptr);
+                             CompressReport* report = nullptr, JointSearchResult* search = nullptr,
+                             double overdraw_cap = 0.0);
 
 }  // namespace cpca
