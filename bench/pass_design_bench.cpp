@@ -40,7 +40,6 @@ struct Row {
 Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOptions o,
         const std::string& row, int per_pass) {
   o.clusters_per_pass = per_pass;
-  double cap = 0;
   if (row == "original") {
     o.method = cpca::ClusterMethod::kLbg;
   } else if (row == "patch-first") {
@@ -50,11 +49,10 @@ Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOption
                                                 : cpca::ClusterMethod::kJoint;
     const auto fields = split_on(row, ':');
     o.lambda = std::stod(fields.at(1));
-    if (fields.size() > 2) cap = std::stod(fields[2]);
+    if (fields.size() > 2) o.overdraw_cap = std::stod(fields[2]);
   }
   cpca::CompressReport report;
-  const cpca::CompressedSet set = cap > 0 ? cpca::compress_joint(x, o, g, &report, nullptr, cap)
-                                          : cpca::compress(x, o, &g, &report);
+  const cpca::CompressedSet set = cpca::compress(x, o, &g, &report);
   Row r;
   r.seconds = report.clustering_seconds() + report.pca_seconds;
   r.se = cpca::error_metrics(x, set).average_squared_error;

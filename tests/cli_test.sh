@@ -124,6 +124,12 @@ run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters
 expect_code 2 && [[ $err == *--lambda* ]]; check "compress: --lambda without a joint method is a usage error" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --method joint --lambda nan
 expect_code 2 && [[ $err == *--lambda* ]]; check "compress: --lambda nan is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --overdraw-cap 1.2
+expect_code 2 && [[ $err == *--overdraw-cap* ]]; check "compress: --overdraw-cap without a joint method is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --method joint --overdraw-cap 0.5
+expect_code 2 && [[ $err == *--overdraw-cap* ]]; check "compress: --overdraw-cap below 1 is a usage error" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/pc.prtc" --clusters 4 --pcs 1 --method patch-joint --clusters-per-pass 2 --lambda 0.5 --overdraw-cap 1.1 -q
+expect_code 0 && [[ $(head -c 8 "$tmp/pc.prtc" 2>/dev/null) == PRTRCMPR ]]; check "compress --method patch-joint --overdraw-cap writes a .prtc" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --method joint --alpha 1
 expect_code 2 && [[ $err == *--alpha* ]]; check "compress: joint with --alpha is a usage error" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --clusters-per-pass 2

@@ -141,25 +141,28 @@ TEST(JointSearch, LargerLambdaDrawsFewerTriangles) {
 TEST(JointSearch, OverdrawCapBoundsTheDraws) {
   const cpca::Geometry g = cpca_test::grid(kN);
   const cpca::DataMatrix x = smooth_data(g, 11);
-  const cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchJoint, 0.01);
+  cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchJoint, 0.01);
   cpca::JointSearchResult free_search;
   cpca::compress_joint(x, o, g, nullptr, &free_search);
   const double free_overdraw = double(free_search.triangles_drawn) / double(g.triangles.size());
   cpca::JointSearchResult first;
-  cpca::compress_joint(x, o, g, nullptr, &first, 1.0);  // the tightest cap there is
+  o.overdraw_cap = 1.0;  // the tightest cap there is
+  cpca::compress_joint(x, o, g, nullptr, &first);
   const double floor_overdraw = double(first.triangles_drawn) / double(g.triangles.size());
   // A cap halfway between what the capped and the free searches reach must bind.
   const double cap = 0.5 * (floor_overdraw + free_overdraw);
   ASSERT_LT(floor_overdraw, cap);
   cpca::JointSearchResult capped;
-  const cpca::CompressedSet set = cpca::compress_joint(x, o, g, nullptr, &capped, cap);
+  o.overdraw_cap = cap;
+  const cpca::CompressedSet set = cpca::compress_joint(x, o, g, nullptr, &capped);
   const std::uint64_t drawn = brute_force_draws(set.cluster_of, g.triangles);
   EXPECT_EQ(capped.triangles_drawn, drawn);
   EXPECT_LE(double(drawn), cap * double(g.triangles.size()));
   EXPECT_LT(drawn, free_search.triangles_drawn);
   for (std::size_t i = 1; i < capped.objective.size(); ++i)
     EXPECT_LE(capped.objective[i], capped.objective[i - 1]) << "stage " << i;
-  EXPECT_THROW(cpca::compress_joint(x, o, g, nullptr, nullptr, 0.5), std::invalid_argument);
+  o.overdraw_cap = 0.5;
+  EXPECT_THROW(cpca::compress_joint(x, o, g), std::invalid_argument);
 }
 
 TEST(JointSearch, OrderProfilePutsTheRoomInTheLastPass) {

@@ -64,6 +64,13 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
                  ->check(finite_number())
                  ->check(CLI::Range(0.0, 1e6))
                  ->capture_default_str();
+  f.cap = cmd->add_option("--overdraw-cap", o.overdraw_cap,
+                          "joint: no vertex move may raise the average overdraw above this "
+                          "(0 = no cap; else >= 1), so a small --lambda spends the allowance "
+                          "on error")
+              ->check(finite_number())
+              ->check(CLI::Range(0.0, 1e6))
+              ->capture_default_str();
 }
 
 namespace {
@@ -86,6 +93,11 @@ cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
         "--clusters-per-pass applies to --method patch-first, joint or patch-joint only");
   if (given(f.lambda) && !joint)
     throw UsageError("--lambda applies to --method joint or patch-joint only");
+  if (given(f.cap) && !joint)
+    throw UsageError("--overdraw-cap applies to --method joint or patch-joint only");
+  if (o.overdraw_cap > 0 && o.overdraw_cap < 1)
+    throw UsageError("--overdraw-cap " + std::to_string(o.overdraw_cap) +
+                     " is below 1, the least average overdraw there is: use 0 (no cap) or >= 1");
   if (joint && (o.alpha > 0 || o.overdraw_reduction))
     throw UsageError("--method " + f.method +
                      " weighs overdraw itself (--lambda): drop --alpha and --overdraw-reduction");

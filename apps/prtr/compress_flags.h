@@ -1,7 +1,8 @@
 // apps/prtr/compress_flags.h: the CPCA flags (--clusters, --pcs, --method, --alpha,
 // --overdraw-reduction, --overdraw-tolerance; and for prtr compress --pca, --seed,
-// --threshold, --max-iterations, --clusters-per-pass, --lambda), registered with one help text by
-// every command that compresses: prtr compress, and prtr relight / overdraw through the cache.
+// --threshold, --max-iterations, --clusters-per-pass, --lambda, --overdraw-cap), registered with
+// one help text by every command that compresses: prtr compress, and prtr relight / overdraw
+// through the cache.
 #pragma once
 
 #include "cpca/compress.h"
@@ -16,7 +17,7 @@ struct CompressFlags {
   cpca::CompressOptions compress;  // the defaults shown in --help
   std::string method = "lbg", pca = "power";
   // Set when registered, so that resolving can tell a given flag from its default.
-  CLI::Option *lambda = nullptr, *per_pass = nullptr;
+  CLI::Option *lambda = nullptr, *per_pass = nullptr, *cap = nullptr;
 };
 
 // Which commands register which flags: prtr compress all of them; relight the ones a cached

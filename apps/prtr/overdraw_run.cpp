@@ -42,8 +42,9 @@ constexpr MethodPreset kMethods[] = {
      true, true},
     {"patch-first", "METIS patches, one per pass, CPCA inside each (designs the passes)", false,
      false, false, cpca::ClusterMethod::kPatchFirst},
-    {"patch-joint", "patch-first, then the joint search of error + 2 x overdraw", false, false,
-     false, cpca::ClusterMethod::kPatchJoint, 2.0},
+    {"patch-joint",
+     "patch-first, then the joint search of error + 0.5 x overdraw, overdraw capped at 1.14", false,
+     false, false, cpca::ClusterMethod::kPatchJoint, 0.5, 1.14},
 };
 
 bool has(const std::vector<std::string>& list, const char* item) {
@@ -222,6 +223,7 @@ Compression compress_row(const Scene& s, const std::string& transfer_path, int k
     co.method = method.designed;
     co.clusters_per_pass = per_pass;
     co.lambda = method.lambda;
+    co.overdraw_cap = method.overdraw_cap;
   }
   const CompressCacheResult compressed =
       cached_compress(transfer_path, s.mesh, plan.mesh, co, plan.cache, true, plan.recompress);

@@ -48,7 +48,7 @@ struct MethodPreset {
   // compress once per budget, for that budget's clusters per pass, and are drawn in cluster
   // order (cpca::designed_passes) instead of by the super-cluster strategies.
   cpca::ClusterMethod designed = cpca::ClusterMethod::kLbg;
-  double lambda = 0;
+  double lambda = 0, overdraw_cap = 0;
   bool designs_passes() const { return designed != cpca::ClusterMethod::kLbg; }
 };
 // PlanError listing the names for an unknown one.

@@ -353,8 +353,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
 
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report, JointSearchResult* search,
-                             double overdraw_cap) {
+                             CompressReport* report, JointSearchResult* search) {
   if (options.alpha != 0 || options.overdraw_reduction)
     throw std::invalid_argument(
         "the joint search takes neither geometry coherence (alpha) nor the overdraw reduction: "
@@ -380,7 +379,7 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   jo.candidates = options.cpca_candidates;
   jo.solver = options.solver;
   jo.seed = options.seed;
-  jo.overdraw_cap = overdraw_cap;
+  jo.overdraw_cap = options.overdraw_cap;
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
   set.method = options.method;

@@ -45,9 +45,11 @@ struct CompressOptions {
   // with the nearest means (0: all clusters, exact but ~K/candidates times slower).
   int cpca_candidates = 16;
   // Methods that design the passes (patch_first.h, joint_search.h): the clusters one render
-  // pass holds, and the joint search's overdraw weight in units of its start's Average SE.
+  // pass holds, the joint search's overdraw weight in units of its start's Average SE, and
+  // its overdraw cap (JointSearchOptions::overdraw_cap; 0 = none).
   int clusters_per_pass = 16;
   double lambda = 0.0;
+  double overdraw_cap = 0.0;
 };
 
 // Triangles whose three vertices lie in 1, 2 or 3 distinct clusters.

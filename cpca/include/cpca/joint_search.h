@@ -74,11 +74,10 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
 // the search, then clusters renumbered so that pass p holds [p * per_pass, (p + 1) *
 // per_pass) (designed_passes() in patch_first.h). Needs the geometry; alpha must be 0. The
 // report's pca_seconds holds the start's fit, refit and grouping, cpca_seconds the search.
-// overdraw_cap is JointSearchOptions::overdraw_cap (the epsilon-constraint form of the
-// trade-off, Haimes et al. 1971; CompressOptions has no field for it).
+// CompressOptions::overdraw_cap is JointSearchOptions::overdraw_cap (the epsilon-constraint
+// form of the trade-off, Haimes et al. 1971).
 CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                              const CompressOptions& options, const Geometry& geometry,
-                             CompressReport* report = nullptr, JointSearchResult* search = nullptr,
-                             double overdraw_cap = 0.0);
+                             CompressReport* report = nullptr, JointSearchResult* search = nullptr);
 
 }  // namespace cpca
