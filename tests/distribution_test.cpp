@@ -118,6 +118,15 @@ cpca::DataMatrix clustered(Eigen::Index rows, Eigen::Index cols, unsigned seed) 
   return x;
 }
 
+// Compression of clustered()'s 9-column rows (order 3, one channel, one row per vertex).
+cpca::CompressOptions small_compression(int clusters, int components) {
+  cpca::CompressOptions options;
+  options.layout = {3, 1, 1};
+  options.clusters = clusters;
+  options.components = components;
+  return options;
+}
+
 TEST(Distribution, RankRowsAreContiguousOnTheGranuleAndCoverEveryRow) {
   for (Eigen::Index rows : {1, 255, 256, 1000, 5000})
     for (int size : {1, 2, 3, 7}) {
@@ -185,10 +194,7 @@ TEST(Distribution, LbgOverRanksEqualsOneProcessBitForBit) {
 
 TEST(Distribution, CompressOverRanksGivesRankZeroTheOneProcessSet) {
   const cpca::DataMatrix x = clustered(1100, 9, 11);
-  cpca::CompressOptions options;
-  options.layout = {3, 1, 1};
-  options.clusters = 20;
-  options.components = 3;
+  const cpca::CompressOptions options = small_compression(20, 3);
   cpca::CompressReport one_report;
   const cpca::CompressedSet one = cpca::compress(cpca::RowBlocks(x), options, nullptr, &one_report);
   for (int ranks : {2, 3}) {
@@ -210,10 +216,7 @@ TEST(Distribution, CompressOverRanksGivesRankZeroTheOneProcessSet) {
 
 TEST(Distribution, MethodsWithoutAChainedFormAreRefused) {
   const cpca::DataMatrix x = clustered(600, 9, 1);
-  cpca::CompressOptions options;
-  options.layout = {3, 1, 1};
-  options.clusters = 8;
-  options.components = 2;
+  cpca::CompressOptions options = small_compression(8, 2);
   options.method = cpca::ClusterMethod::kIterative;
   const auto refused = run_ranks(2, [&](cpca::Distribution& d) {
     try {
