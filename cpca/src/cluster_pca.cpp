@@ -134,8 +134,9 @@ ClusterShare pack_share(const CompressedSet& set, const std::vector<double>& err
   return out;
 }
 
-void unpack_share(CompressedSet& set, std::vector<double>& error, const float* floats,
-                  const double* errors, const std::vector<std::vector<std::uint32_t>>& members,
+// The inverse of pack_share; advances `floats` and `errors` past what it read.
+void unpack_share(CompressedSet& set, std::vector<double>& error, const float*& floats,
+                  const double*& errors, const std::vector<std::vector<std::uint32_t>>& members,
                   int rank, int ranks) {
   const std::size_t n = std::size_t(set.component_count);
   walk_share(set, members, rank, ranks,
@@ -180,10 +181,7 @@ std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaS
       const double* ep = e.data();
       own.power_iterations = 0;
       for (int r = 0; r < ranks; ++r) {
-        const ClusterShare sizes = pack_share(set, error, members, r, ranks);
         unpack_share(set, error, fp, ep, members, r, ranks);
-        fp += sizes.floats.size();
-        ep += sizes.errors.size();
         own.power_iterations += int(*ep++);
       }
     }
