@@ -20,6 +20,7 @@
 #include <fstream>
 #include <mutex>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,7 @@ using RowMatF = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowM
 using detail::HitBlock;
 using detail::HitRecord;
 using detail::kChunk;
+using detail::VertexList;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -451,22 +453,24 @@ void record_front_hits(const BakeContext& ctx, ShadowScratch& s, int k, HitBlock
 // Per-vertex outcome of the shadow pass.
 enum VertexFlag : std::uint8_t { kNearly = 1, kMoved = 2 };
 
-// Direct light: the shadow-pass transfer of vertices [first, last) into dst, and (with
-// bounces) the front hits each vertex's occluded rays find. flags[p] has kNearly where p
-// sees less than kNearlyOccluded of its rays escape, and kMoved where its origin was moved
-// out of the body.
-void shadow_range(const BakeContext& ctx, ShadowPool& pool, std::uint64_t first, std::uint64_t last,
-                  float* dst, std::vector<HitBlock>* hit_blocks, std::vector<std::uint8_t>& flags,
+// Direct light: the shadow-pass transfer of `vertices` into dst (row i for vertices[i]),
+// and (with bounces) the front hits each vertex's occluded rays find, per kChunk of them. flags[p]
+// has kNearly where p sees less than kNearlyOccluded of its rays escape, and kMoved where its
+// origin was moved out of the body.
+void shadow_range(const BakeContext& ctx, ShadowPool& pool, VertexList vertices, float* dst,
+                  std::vector<HitBlock>* hit_blocks, std::vector<std::uint8_t>& flags,
                   ProgressReporter& progress) {
   const double visible_floor = kNearlyOccluded * ctx.setup.samples;
-  const std::uint64_t chunks = (last - first + kChunk - 1) / kChunk;
+  const std::uint64_t count = vertices.size();
+  const std::uint64_t chunks = (count + kChunk - 1) / kChunk;
   if (hit_blocks) hit_blocks->assign(chunks, HitBlock{});
   tbb::parallel_for(std::uint64_t(0), chunks, [&](std::uint64_t chunk) {
     ShadowScratch& s = pool.local();
-    const std::uint64_t begin = first + chunk * kChunk, end = std::min(last, begin + kChunk);
+    const std::uint64_t begin = chunk * kChunk, end = std::min(count, begin + kChunk);
     HitBlock* block = hit_blocks ? &(*hit_blocks)[chunk] : nullptr;
     if (block) block->offsets.assign(1, 0);
-    for (std::uint64_t p = begin; p < end; ++p) {
+    for (std::uint64_t i = begin; i < end; ++i) {
+      const std::uint32_t p = vertices[i];
       const Eigen::Matrix3f frame = frame_of(ctx.mesh, p);
       int k = trace_shadow_rays(ctx, s, p, frame);
       auto dark = [&] { return double(ctx.setup.samples - k) < visible_floor; };
@@ -482,7 +486,7 @@ void shadow_range(const BakeContext& ctx, ShadowPool& pool, std::uint64_t first,
       }
       flags[p] = flag;
       s.occluded_count += k;
-      float* out = dst + (p - first) * ctx.per_vertex;
+      float* out = dst + i * ctx.per_vertex;
       if (ctx.glossy) {
         glossy_shadow_transfer(ctx, s, k, frame, out);
       } else {
@@ -510,24 +514,33 @@ struct BounceScratch {
 };
 using BouncePool = tbb::enumerable_thread_specific<BounceScratch>;
 
+// A vertex's frame, stored with its row of the previous pass: a hit's corners are read
+// together with their transfer.
+struct CornerFrame {
+  Eigen::Vector3f tangent, bitangent, normal;
+};
+
 // The previous bounce's transfer of every vertex, with its layout.
 struct BounceSource {
-  const float* previous;  // M^{b-1}
+  const float* previous;        // M^{b-1}
+  const std::uint32_t* row_of;  // vertex q is row row_of[q] of previous; null: row q
+  const CornerFrame* frames;    // by row
   std::size_t per_vertex, per_channel;
+  std::size_t row_index(std::uint32_t q) const { return row_of ? row_of[q] : q; }
+  const float* row(std::uint32_t q) const { return previous + row_index(q) * per_vertex; }
 };
 
 // Glossy corners emit toward p: the directions back to p seen from each hit triangle's
 // corners, in the corners' frames, and their SH values.
-void corner_view_directions(const BakeContext& ctx, BounceScratch& s, const HitRecord* hits,
-                            int count, const Eigen::Matrix3f& frame) {
-  const meshes::Mesh& mesh = ctx.mesh;
+void corner_view_directions(const BakeContext& ctx, BounceScratch& s, const BounceSource& src,
+                            const HitRecord* hits, int count, const Eigen::Matrix3f& frame) {
   for (int h = 0; h < count; ++h) {
     const Eigen::Vector3f back = -(frame * ctx.setup.directions.col(hits[h].direction));
-    const meshes::Triangle& tri = mesh.triangles[hits[h].triangle];
+    const meshes::Triangle& tri = ctx.mesh.triangles[hits[h].triangle];
     for (int c = 0; c < 3; ++c) {
-      const std::uint32_t q = tri[c];
-      s.corner_dirs.col(3 * h + c) << mesh.tangents[q].dot(back), mesh.bitangents[q].dot(back),
-          mesh.normals[q].dot(back);
+      const CornerFrame& f = src.frames[src.row_index(tri[c])];
+      s.corner_dirs.col(3 * h + c) << f.tangent.dot(back), f.bitangent.dot(back),
+          f.normal.dot(back);
     }
   }
   sh_eval_batch(ctx.options.order, s.corner_dirs.leftCols(3 * count), s.corner_batch);
@@ -544,7 +557,7 @@ void hit_radiance_rows(const BakeContext& ctx, BounceScratch& s, const BounceSou
     const meshes::Triangle& tri = ctx.mesh.triangles[hits[h].triangle];
     const float beta[3] = {1.f - hits[h].u - hits[h].v, hits[h].u, hits[h].v};
     for (int c = 0; c < 3; ++c) {
-      const float* corner = src.previous + tri[c] * src.per_vertex + ch * src.per_channel;
+      const float* corner = src.row(tri[c]) + ch * src.per_channel;
       if (ctx.glossy) {
         s.rows.row(h).noalias() += beta[c] * (s.corner_y.col(3 * h + c).transpose() *
                                               Eigen::Map<const RowMatF>(corner, n, n));
@@ -564,7 +577,7 @@ void bounce_vertex(const BakeContext& ctx, BounceScratch& s, const BounceSource&
     std::fill(dst, dst + src.per_vertex, 0.f);
     return;
   }
-  if (ctx.glossy) corner_view_directions(ctx, s, hits, count, frame_of(ctx.mesh, p));
+  if (ctx.glossy) corner_view_directions(ctx, s, src, hits, count, frame_of(ctx.mesh, p));
   for (int h = 0; h < count; ++h) s.y_hit.col(h) = setup.y.col(hits[h].direction);
   for (int ch = 0; ch < ctx.channels; ++ch) {
     hit_radiance_rows(ctx, s, src, hits, count, ch);
@@ -581,21 +594,22 @@ void bounce_vertex(const BakeContext& ctx, BounceScratch& s, const BounceSource&
   }
 }
 
-// One interreflection pass over vertices [first, last): their bounce-b transfer, into dst,
-// from bounce b - 1's of every vertex (src).
+// One interreflection pass over `vertices`: their bounce-b transfer, into dst (row i for
+// vertices[i]), from bounce b - 1's of every vertex (src).
 void bounce_range(const BakeContext& ctx, BouncePool& pool, const std::vector<HitBlock>& hit_blocks,
-                  const BounceSource& src, std::uint64_t first, std::uint64_t last, float* dst,
+                  const BounceSource& src, VertexList vertices, float* dst,
                   ProgressReporter& progress) {
-  const std::uint64_t chunks = (last - first + kChunk - 1) / kChunk;
+  const std::uint64_t count = vertices.size();
+  const std::uint64_t chunks = (count + kChunk - 1) / kChunk;
   tbb::parallel_for(std::uint64_t(0), chunks, [&](std::uint64_t chunk) {
     BounceScratch& s = pool.local();
     const HitBlock& block = hit_blocks[chunk];
-    const std::uint64_t begin = first + chunk * kChunk, end = std::min(last, begin + kChunk);
-    for (std::uint64_t p = begin; p < end; ++p) {
-      const std::uint32_t at = block.offsets[p - begin];
-      const int count = int(block.offsets[p - begin + 1] - at);
-      bounce_vertex(ctx, s, src, block.records.data() + at, count, p,
-                    dst + (p - first) * src.per_vertex);
+    const std::uint64_t begin = chunk * kChunk, end = std::min(count, begin + kChunk);
+    for (std::uint64_t i = begin; i < end; ++i) {
+      const std::uint32_t at = block.offsets[i - begin];
+      const int hits = int(block.offsets[i - begin + 1] - at);
+      bounce_vertex(ctx, s, src, block.records.data() + at, hits, vertices[i],
+                    dst + i * src.per_vertex);
     }
     progress.add(end - begin);
   });
@@ -623,6 +637,9 @@ struct BakeEngine::State {
   ShadowPool shadow_pool;
   BouncePool bounce_pool;
   std::vector<std::uint8_t> flags;
+  // The frames in the row order of the previous pass that bounces read (frames_row_of).
+  std::vector<CornerFrame> frames;
+  const std::uint32_t* frames_row_of = nullptr;
   std::uint64_t shaded = 0;  // vertices through the shadow pass (a shard's range)
 };
 
@@ -682,22 +699,36 @@ void BakeEngine::finish_pass() {
   state_->progress.finish_pass();
 }
 
-void BakeEngine::shadow(std::uint64_t begin, std::uint64_t end, float* dst,
-                        std::vector<HitBlock>* hits) {
+void BakeEngine::shadow(VertexList vertices, float* dst, std::vector<HitBlock>* hits) {
   const auto start = Clock::now();
   State& st = *state_;
-  shadow_range(st.ctx, st.shadow_pool, begin, end, dst, hits, st.flags, st.progress);
-  st.shaded += end - begin;
+  shadow_range(st.ctx, st.shadow_pool, vertices, dst, hits, st.flags, st.progress);
+  st.shaded += vertices.size();
   st.stats.seconds_shadow += seconds_since(start);
 }
 
-void BakeEngine::bounce(std::uint64_t begin, std::uint64_t end, const std::vector<HitBlock>& hits,
-                        const float* previous, float* dst) {
+void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
+                        const float* previous, const std::uint32_t* row_of, float* dst) {
   const auto start = Clock::now();
   State& st = *state_;
-  const BounceSource src{previous, st.ctx.per_vertex, st.ctx.per_channel};
-  bounce_range(st.ctx, st.bounce_pool, hits, src, begin, end, dst, st.progress);
+  if (st.frames.empty() || st.frames_row_of != row_of) {
+    const meshes::Mesh& mesh = st.ctx.mesh;
+    st.frames.resize(mesh.vertex_count());
+    for (std::uint32_t q = 0; q < mesh.vertex_count(); ++q) {
+      st.frames[row_of ? row_of[q] : q] =
+          CornerFrame{mesh.tangents[q], mesh.bitangents[q], mesh.normals[q]};
+    }
+    st.frames_row_of = row_of;
+  }
+  const BounceSource src{previous, row_of, st.frames.data(), st.ctx.per_vertex, st.ctx.per_channel};
+  bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, dst, st.progress);
   st.stats.seconds_bounces += seconds_since(start);
+}
+
+std::vector<std::uint32_t> index_range(std::uint64_t begin, std::uint64_t end) {
+  std::vector<std::uint32_t> out(end - begin);
+  std::iota(out.begin(), out.end(), std::uint32_t(begin));
+  return out;
 }
 
 void BakeEngine::finish() {
@@ -729,15 +760,16 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
   const std::uint64_t v = engine.vertex_count();
   out.data.assign(v * engine.floats_per_vertex(), 0.f);
   std::vector<HitBlock> hits;
+  const std::vector<std::uint32_t> all = detail::index_range(0, v);
   engine.start_pass(0);
-  engine.shadow(0, v, out.data.data(), o.bounces > 0 ? &hits : nullptr);
+  engine.shadow(all, out.data.data(), o.bounces > 0 ? &hits : nullptr);
   engine.finish_pass();
   if (o.bounces > 0) {
     std::vector<float> previous = out.data;  // M^{b-1}; starts as the shadow pass
     std::vector<float> current(out.data.size());
     for (int bounce = 1; bounce <= o.bounces; ++bounce) {
       engine.start_pass(bounce);
-      engine.bounce(0, v, hits, previous.data(), current.data());
+      engine.bounce(all, hits, previous.data(), nullptr, current.data());
       engine.finish_pass();
       for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] += current[i];
       previous.swap(current);

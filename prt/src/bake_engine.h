@@ -7,11 +7,18 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace prt::detail {
 
 inline constexpr std::uint64_t kChunk = 64;  // vertices per scheduling unit (and hit block)
+
+// The vertices a pass computes, in the order their rows are written.
+using VertexList = std::span<const std::uint32_t>;
+
+// The vertices [begin, end) in index order.
+std::vector<std::uint32_t> index_range(std::uint64_t begin, std::uint64_t end);
 
 // An occluded ray that hit the front of a triangle: what a bounce needs of it.
 struct HitRecord {
@@ -42,13 +49,14 @@ class BakeEngine {
   void start_pass(int pass);
   void finish_pass();
 
-  // Shadow pass of vertices [begin, end) into dst ((end - begin) x floats_per_vertex). With
-  // bounces, `hits` gets the front hits of each kChunk vertices from begin.
-  void shadow(std::uint64_t begin, std::uint64_t end, float* dst, std::vector<HitBlock>* hits);
-  // One bounce of vertices [begin, end) into dst, from the whole previous pass `previous`
-  // (vertex_count x floats_per_vertex) and the range's hits as shadow() gave them.
-  void bounce(std::uint64_t begin, std::uint64_t end, const std::vector<HitBlock>& hits,
-              const float* previous, float* dst);
+  // Shadow pass of `vertices` into dst (vertices.size() x floats_per_vertex, row i for
+  // vertices[i]). With bounces, `hits` gets the front hits of each kChunk of them.
+  void shadow(VertexList vertices, float* dst, std::vector<HitBlock>* hits);
+  // One bounce of `vertices` into dst, from the whole previous pass `previous`
+  // (vertex_count x floats_per_vertex; vertex q in row row_of[q], or row q if row_of is
+  // null) and the list's hits as shadow() gave them for the same list.
+  void bounce(VertexList vertices, const std::vector<HitBlock>& hits, const float* previous,
+              const std::uint32_t* row_of, float* dst);
   // Fills the remaining stats (ray counts, flagged vertices, total time).
   void finish();
 

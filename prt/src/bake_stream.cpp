@@ -6,6 +6,7 @@
 #include "bake_engine.h"
 #include "common/atomic_file.h"
 #include "common/mapped_file.h"
+#include "meshes/spatial_order.h"
 #include "prt/transfer_file.h"
 #include "prt/transfer_shard.h"
 
@@ -27,6 +28,7 @@ namespace fs = std::filesystem;
 using detail::HitBlock;
 using detail::HitRecord;
 using detail::kChunk;
+using detail::VertexList;
 
 // A pass's intermediate data on disk: an AtomicFile beside the output that is never
 // committed, so it vanishes with the bake (or is swept after a crash), read back through
@@ -91,12 +93,45 @@ fs::path scratch_target(const fs::path& path, const std::string& what) {
   return path.parent_path() / (path.filename().string() + "." + what);
 }
 
-// The bounce passes: bounce b reads M^{b-1} of every vertex through a map of the previous
-// pass's scratch file, and the running sum S^{b-1} block by block, and writes
-// S^b = S^{b-1} + M^b (to the output on the last bounce) and M^b (for the next bounce).
-void stream_bounces(detail::BakeEngine& engine, int bounces, std::uint64_t block,
-                    const fs::path& path, const HitStore& hits,
-                    std::shared_ptr<Scratch> previous_pass, TransferFileWriter& writer) {
+// The vertices of a bake with bounces in spatial order (meshes::spatial_order), and where
+// each one's row is: every pass and running sum is stored in that order.
+struct Layout {
+  explicit Layout(const meshes::Mesh& mesh)
+      : order(meshes::spatial_order(mesh)), row_of(meshes::inverse_permutation(order)) {}
+  VertexList block(std::uint64_t begin, std::uint64_t end) const {
+    return VertexList(order).subspan(begin, end - begin);
+  }
+  std::vector<std::uint32_t> order, row_of;
+};
+
+// The rows of `rows` (a pass of every vertex in layout order) of vertices [first, last),
+// appended to `append` in index order, `block` vertices at a time. Read row by row rather
+// than mapped: the reads jump through the file, and a map's fault-around would make each
+// 5 KB row cost 64 KB of resident pages.
+template <class Rows>
+void append_in_index_order(const Rows& rows, const Layout& layout, std::uint64_t first,
+                           std::uint64_t last, std::size_t per_vertex, std::uint64_t block,
+                           const std::function<void(const float*, std::size_t)>& append) {
+  std::vector<float> buffer(std::min(block, last - first) * per_vertex);
+  const std::size_t row_bytes = per_vertex * sizeof(float);
+  for (std::uint64_t begin = first; begin < last; begin += block) {
+    const std::uint64_t end = std::min(last, begin + block);
+    for (std::uint64_t q = begin; q < end; ++q) {
+      rows.read(buffer.data() + (q - begin) * per_vertex, row_bytes,
+                std::uint64_t(layout.row_of[q]) * row_bytes);
+    }
+    append(buffer.data(), (end - begin) * per_vertex);
+  }
+}
+
+// The bounce passes, over the vertices in layout order: bounce b reads M^{b-1} of every
+// vertex through a map of the previous pass's scratch file, and the running sum S^{b-1}
+// block by block, and writes S^b = S^{b-1} + M^b and M^b (for the next bounce). Returns the
+// file of the last S^b, in layout order.
+std::shared_ptr<Scratch> stream_bounces(detail::BakeEngine& engine, const Layout& layout,
+                                        int bounces, std::uint64_t block, const fs::path& path,
+                                        const HitStore& hits,
+                                        std::shared_ptr<Scratch> previous_pass) {
   const std::uint64_t v = engine.vertex_count();
   const std::size_t per_vertex = engine.floats_per_vertex();
   std::shared_ptr<Scratch> previous_sum = previous_pass;  // S^0 = M^0
@@ -104,11 +139,8 @@ void stream_bounces(detail::BakeEngine& engine, int bounces, std::uint64_t block
   std::vector<HitBlock> hit_blocks;
   for (int b = 1; b <= bounces; ++b) {
     const bool last = b == bounces;
-    std::shared_ptr<Scratch> pass, running;
-    if (!last) {
-      pass = std::make_shared<Scratch>(scratch_target(path, "bounce"));
-      running = std::make_shared<Scratch>(scratch_target(path, "sum"));
-    }
+    auto pass = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "bounce"));
+    auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
     const common::MappedFile map(previous_pass->path());
     const auto* m_previous = reinterpret_cast<const float*>(map.data());
     engine.start_pass(b);
@@ -117,15 +149,12 @@ void stream_bounces(detail::BakeEngine& engine, int bounces, std::uint64_t block
       // Every block but the last has `block` vertices, so the same number of chunks.
       const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
       hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(begin, end, hit_blocks, m_previous, current.data());
+      engine.bounce(layout.block(begin, end), hit_blocks, m_previous, layout.row_of.data(),
+                    current.data());
       previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
-      if (last) {
-        writer.append(sum.data(), n);
-      } else {
-        pass->write(current.data(), n * sizeof(float));
-        running->write(sum.data(), n * sizeof(float));
-      }
+      if (pass) pass->write(current.data(), n * sizeof(float));
+      running->write(sum.data(), n * sizeof(float));
       // What this block touched of M^{b-1} leaves the resident set; the next block's hits
       // fault in their own neighbourhood from the page cache.
       map.release();
@@ -134,6 +163,7 @@ void stream_bounces(detail::BakeEngine& engine, int bounces, std::uint64_t block
     previous_pass = pass;
     previous_sum = running;
   }
+  return previous_sum;
 }
 
 // A pass of every vertex in one file beside the output, which each rank of a distributed
@@ -161,6 +191,9 @@ class SharedPass {
       left -= std::size_t(n);
     }
   }
+  void read(void* out, std::size_t bytes, std::uint64_t offset) const {
+    common::read_exact(fd_, out, bytes, offset, path_.c_str());
+  }
   const fs::path& path() const { return path_; }
 
  private:
@@ -168,17 +201,17 @@ class SharedPass {
   int fd_ = -1;
 };
 
-// The shadow pass of one rank's range: M^0 to the shared pass, S^0 = M^0 and the hits to
-// the rank's own scratch files.
-void rank_shadow(detail::BakeEngine& engine, const ShardRange& range, std::uint64_t block,
-                 SharedPass& pass, Scratch& sum, HitStore& hits) {
+// The shadow pass of one rank's range of the layout: M^0 to the shared pass, S^0 = M^0 and
+// the hits to the rank's own scratch files.
+void rank_shadow(detail::BakeEngine& engine, const Layout& layout, const ShardRange& range,
+                 std::uint64_t block, SharedPass& pass, Scratch& sum, HitStore& hits) {
   const std::size_t per_vertex = engine.floats_per_vertex();
   std::vector<float> buffer(std::min(range.end - range.first, block) * per_vertex);
   std::vector<HitBlock> hit_blocks;
   engine.start_pass(0);
   for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
     const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
-    engine.shadow(begin, end, buffer.data(), &hit_blocks);
+    engine.shadow(layout.block(begin, end), buffer.data(), &hit_blocks);
     pass.write(buffer.data(), n, begin * per_vertex);
     sum.write(buffer.data(), n * sizeof(float));
     hits.store(hit_blocks);
@@ -197,6 +230,8 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
   detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
   const TransferSet shape = engine.shape();
   const std::uint64_t v = engine.vertex_count();
+  const Layout layout(mesh);
+  // The rank computes a range of the layout, and writes the index range of its shard.
   const ShardRange range = shard_range(v, index, count);
   const std::size_t per_vertex = engine.floats_per_vertex();
   const std::uint64_t block = std::max<std::uint64_t>(
@@ -207,7 +242,7 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
                           SharedPass(shared_prefix.string() + ".pass1")};
   HitStore hits(scratch_target(path, "hits"));
   auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
-  rank_shadow(engine, range, block, passes[0], *running, hits);
+  rank_shadow(engine, layout, range, block, passes[0], *running, hits);
   barrier();  // every rank's M^0 is in passes[0]
   std::vector<float> current(block * per_vertex), sum(block * per_vertex);
   std::vector<HitBlock> hit_blocks;
@@ -224,24 +259,25 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
       const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
       const std::uint64_t local = begin - range.first;
       hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(begin, end, hit_blocks, reinterpret_cast<const float*>(map.data()),
+      engine.bounce(layout.block(begin, end), hit_blocks,
+                    reinterpret_cast<const float*>(map.data()), layout.row_of.data(),
                     current.data());
       running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
-      if (last) {
-        writer.append(sum.data(), n);
-      } else {
-        passes[b % 2].write(current.data(), n, begin * per_vertex);
-        next_running->write(sum.data(), n * sizeof(float));
-      }
+      // The last pass's sums take the place of M^b: the shard is in index order, and its
+      // rows come from every rank's range of the layout.
+      passes[b % 2].write(last ? sum.data() : current.data(), n, begin * per_vertex);
+      if (!last) next_running->write(sum.data(), n * sizeof(float));
       map.release();
     }
     engine.finish_pass();
     running = next_running;
-    // Every rank's M^b is written, and nobody reads M^(b-1) any more, whose file pass b + 1
-    // overwrites.
-    if (!last) barrier();
+    // Every rank's M^b (or S^b) is written, and nobody reads M^(b-1) any more, whose file
+    // pass b + 1 overwrites.
+    barrier();
   }
+  append_in_index_order(passes[o.bounces % 2], layout, range.first, range.end, per_vertex, block,
+                        [&](const float* rows, std::size_t n) { writer.append(rows, n); });
   writer.commit();
   engine.finish();
   return shape;
@@ -263,31 +299,35 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
   const std::uint64_t v = engine.vertex_count();
   const std::size_t per_vertex = engine.floats_per_vertex();
   const std::uint64_t block =
-      block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex);
+      std::min(v, block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex));
   TransferFileWriter writer(path, shape);
-  std::vector<float> buffer(std::min(v, block) * per_vertex);
-  std::shared_ptr<Scratch> shadow_pass;
-  std::unique_ptr<HitStore> hits;
-  if (o.bounces > 0) {
-    shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
-    hits = std::make_unique<HitStore>(scratch_target(path, "hits"));
-  }
-  std::vector<HitBlock> hit_blocks;
+  std::vector<float> buffer(block * per_vertex);
   engine.start_pass(0);
-  for (std::uint64_t begin = 0; begin < v; begin += block) {
-    const std::uint64_t end = std::min(v, begin + block), n = (end - begin) * per_vertex;
-    engine.shadow(begin, end, buffer.data(), hits ? &hit_blocks : nullptr);
-    if (hits) {
-      shadow_pass->write(buffer.data(), n * sizeof(float));
-      hits->store(hit_blocks);
-    } else {
-      writer.append(buffer.data(), n);
+  if (o.bounces == 0) {
+    // Nothing reads another vertex's transfer: index order, straight to the output.
+    for (std::uint64_t begin = 0; begin < v; begin += block) {
+      const std::uint64_t end = std::min(v, begin + block);
+      engine.shadow(detail::index_range(begin, end), buffer.data(), nullptr);
+      writer.append(buffer.data(), (end - begin) * per_vertex);
     }
-  }
-  engine.finish_pass();
-  buffer = {};
-  if (o.bounces > 0) {
-    stream_bounces(engine, o.bounces, std::min(v, block), path, *hits, shadow_pass, writer);
+    engine.finish_pass();
+  } else {
+    const Layout layout(mesh);
+    auto shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
+    HitStore hits(scratch_target(path, "hits"));
+    std::vector<HitBlock> hit_blocks;
+    for (std::uint64_t begin = 0; begin < v; begin += block) {
+      const std::uint64_t end = std::min(v, begin + block);
+      engine.shadow(layout.block(begin, end), buffer.data(), &hit_blocks);
+      shadow_pass->write(buffer.data(), (end - begin) * per_vertex * sizeof(float));
+      hits.store(hit_blocks);
+    }
+    engine.finish_pass();
+    buffer = {};
+    const std::shared_ptr<Scratch> sums =
+        stream_bounces(engine, layout, o.bounces, block, path, hits, shadow_pass);
+    append_in_index_order(*sums, layout, 0, v, per_vertex, block,
+                          [&](const float* rows, std::size_t n) { writer.append(rows, n); });
   }
   writer.commit();
   engine.finish();
@@ -320,7 +360,7 @@ TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& o, c
   engine.start_pass(0);
   for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
     const std::uint64_t end = std::min(range.end, begin + block);
-    engine.shadow(begin, end, buffer.data(), nullptr);
+    engine.shadow(detail::index_range(begin, end), buffer.data(), nullptr);
     writer.append(buffer.data(), (end - begin) * per_vertex);
   }
   engine.finish_pass();
