@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The scale paths of the prtr binary against the one-process results, byte for byte:
-#   blocks  prtr compress out of core with tiny blocks equals the default block size.
+#   blocks  prtr compress out of core with tiny blocks equals the default block size, and
+#           prtr --threads 1 equals every core (bake with a bounce, compress).
 #   mpi     mpirun -np 2 and -np 3 (oversubscribed, localhost only) prtr bake (0, 1 or 2
 #           bounces) and prtr compress equal the one-process results byte for byte; a failing
 #           rank fails the job and leaves no output. Exit 77
@@ -49,6 +50,17 @@ if [[ $mode == blocks ]]; then
     -q --block-vertices 1 >/dev/null
   check "compress, --block-vertices 1" $?
   cmp "$tmp/default.prtc" "$tmp/tiny.prtc"; check "out-of-core compress equals default" $?
+  # One worker thread gives the same bytes as every core: no sum depends on the scheduling.
+  "$prtr" "${bounced[@]}" --bounces 1 -o "$tmp/all.prtx" >/dev/null; check "bake, 1 bounce" $?
+  "$prtr" --threads 1 "${bounced[@]}" --bounces 1 -o "$tmp/serial.prtx" >/dev/null
+  check "prtr --threads 1 bake" $?
+  cmp "$tmp/all.prtx" "$tmp/serial.prtx"; check "--threads 1 bake equals every core" $?
+  "$prtr" --threads 1 compress "$tmp/one.prtx" --mesh "$mesh" -o "$tmp/serial.prtc" \
+    --clusters 24 --pcs 2 -q >/dev/null
+  cmp "$tmp/default.prtc" "$tmp/serial.prtc"; check "--threads 1 compress equals every core" $?
+  "$prtr" --threads -1 bake "$mesh" -o "$tmp/bad.prtx" >/dev/null 2>"$tmp/threads.err"
+  [[ $? == 2 ]] && grep -q -- "--threads" "$tmp/threads.err"
+  check "--threads -1 is a usage error naming the flag" $?
   exit $((failed > 0))
 fi
 

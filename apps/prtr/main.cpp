@@ -3,9 +3,12 @@
 #include "commands.h"
 #include "start_sweep.h"
 
+#include <tbb/global_control.h>
+
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <memory>
 #include <string>
 
 int main(int argc, char** argv) {
@@ -13,6 +16,12 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "prtr 0.1.0");
   app.require_subcommand(1);
   app.failure_message(CLI::FailureMessage::simple);
+  int threads = 0;
+  app.add_option("--threads", threads,
+                 "Worker threads at most (0: every core; under mpirun, each rank gets the node's "
+                 "cores divided by its ranks). Results do not depend on it")
+      ->check(CLI::Range(0, 65536))
+      ->capture_default_str();
 
   std::map<const CLI::App*, prtr_app::Runner> runners;
   auto add = [&](prtr_app::Runner (*adder)(CLI::App&)) {
@@ -36,6 +45,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // --help and --version exit 0; every other parse failure is a usage error.
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  std::unique_ptr<tbb::global_control> thread_cap;
+  if (threads > 0) {
+    thread_cap = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                       std::size_t(threads));
   }
   try {
     for (CLI::App* sub : app.get_subcommands()) {
