@@ -116,6 +116,11 @@ for bounces in 1 2; do
   fi
   for ranks in $((4 - bounces)); do
     out=$tmp/mpi$ranks-b$bounces.prtx
+    if [[ $bounces == 2 ]]; then
+      # Pass files a crashed run left behind, one longer and one shorter than a pass: every
+      # byte a pass reads is rewritten first, so they change nothing.
+      head -c 4000000 /dev/urandom >"$out.pass0"; head -c 1000 /dev/urandom >"$out.pass1"
+    fi
     mpi "$ranks" "${bounced[@]}" --bounces $bounces --block-vertices 37 -o "$out" \
       >"$tmp/b$ranks.log" 2>&1
     check "mpirun -np $ranks bake --bounces $bounces exits 0" $?
