@@ -324,8 +324,10 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
     }
     engine.finish_pass();
     buffer = {};
+    // Handed over, so that the shadow pass's scratch is removed as soon as the bounces are
+    // done with it, not kept beside the output while it is written.
     const std::shared_ptr<Scratch> sums =
-        stream_bounces(engine, layout, o.bounces, block, path, hits, shadow_pass);
+        stream_bounces(engine, layout, o.bounces, block, path, hits, std::move(shadow_pass));
     append_in_index_order(*sums, layout, 0, v, per_vertex, block,
                           [&](const float* rows, std::size_t n) { writer.append(rows, n); });
   }
