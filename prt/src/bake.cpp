@@ -637,9 +637,10 @@ struct BakeEngine::State {
   ShadowPool shadow_pool;
   BouncePool bounce_pool;
   std::vector<std::uint8_t> flags;
-  // The frames in the row order of the previous pass that bounces read (frames_row_of).
+  // Where bounces find vertex q in the previous pass (null: row q), and the frames in that
+  // row order (set_row_order).
+  const std::uint32_t* row_of = nullptr;
   std::vector<CornerFrame> frames;
-  const std::uint32_t* frames_row_of = nullptr;
   std::uint64_t shaded = 0;  // vertices through the shadow pass (a shard's range)
 };
 
@@ -707,20 +708,24 @@ void BakeEngine::shadow(VertexList vertices, float* dst, std::vector<HitBlock>* 
   st.stats.seconds_shadow += seconds_since(start);
 }
 
+void BakeEngine::set_row_order(const std::uint32_t* row_of) {
+  State& st = *state_;
+  const meshes::Mesh& mesh = st.ctx.mesh;
+  st.frames.resize(mesh.vertex_count());
+  for (std::uint32_t q = 0; q < mesh.vertex_count(); ++q) {
+    st.frames[row_of ? row_of[q] : q] =
+        CornerFrame{mesh.tangents[q], mesh.bitangents[q], mesh.normals[q]};
+  }
+  st.row_of = row_of;
+}
+
 void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
-                        const float* previous, const std::uint32_t* row_of, float* dst) {
+                        const float* previous, float* dst) {
   const auto start = Clock::now();
   State& st = *state_;
-  if (st.frames.empty() || st.frames_row_of != row_of) {
-    const meshes::Mesh& mesh = st.ctx.mesh;
-    st.frames.resize(mesh.vertex_count());
-    for (std::uint32_t q = 0; q < mesh.vertex_count(); ++q) {
-      st.frames[row_of ? row_of[q] : q] =
-          CornerFrame{mesh.tangents[q], mesh.bitangents[q], mesh.normals[q]};
-    }
-    st.frames_row_of = row_of;
-  }
-  const BounceSource src{previous, row_of, st.frames.data(), st.ctx.per_vertex, st.ctx.per_channel};
+  if (st.frames.empty()) set_row_order(nullptr);
+  const BounceSource src{previous, st.row_of, st.frames.data(), st.ctx.per_vertex,
+                         st.ctx.per_channel};
   bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, dst, st.progress);
   st.stats.seconds_bounces += seconds_since(start);
 }
@@ -769,7 +774,7 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stat
     std::vector<float> current(out.data.size());
     for (int bounce = 1; bounce <= o.bounces; ++bounce) {
       engine.start_pass(bounce);
-      engine.bounce(all, hits, previous.data(), nullptr, current.data());
+      engine.bounce(all, hits, previous.data(), current.data());
       engine.finish_pass();
       for (std::size_t i = 0; i < out.data.size(); ++i) out.data[i] += current[i];
       previous.swap(current);

@@ -52,11 +52,14 @@ class BakeEngine {
   // Shadow pass of `vertices` into dst (vertices.size() x floats_per_vertex, row i for
   // vertices[i]). With bounces, `hits` gets the front hits of each kChunk of them.
   void shadow(VertexList vertices, float* dst, std::vector<HitBlock>* hits);
+  // The row order every previous pass is stored in for bounce(): vertex q in row row_of[q]
+  // (null, the default: row q). row_of must outlive the bounces.
+  void set_row_order(const std::uint32_t* row_of);
   // One bounce of `vertices` into dst, from the whole previous pass `previous`
-  // (vertex_count x floats_per_vertex; vertex q in row row_of[q], or row q if row_of is
-  // null) and the list's hits as shadow() gave them for the same list.
+  // (vertex_count x floats_per_vertex, in the row order) and the list's hits as shadow()
+  // gave them for the same list.
   void bounce(VertexList vertices, const std::vector<HitBlock>& hits, const float* previous,
-              const std::uint32_t* row_of, float* dst);
+              float* dst);
   // Fills the remaining stats (ray counts, flagged vertices, total time).
   void finish();
 

@@ -149,8 +149,7 @@ std::shared_ptr<Scratch> stream_bounces(detail::BakeEngine& engine, const Layout
       // Every block but the last has `block` vertices, so the same number of chunks.
       const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
       hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks, m_previous, layout.row_of.data(),
-                    current.data());
+      engine.bounce(layout.block(begin, end), hit_blocks, m_previous, current.data());
       previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
       if (pass) pass->write(current.data(), n * sizeof(float));
@@ -231,6 +230,7 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
   const TransferSet shape = engine.shape();
   const std::uint64_t v = engine.vertex_count();
   const Layout layout(mesh);
+  engine.set_row_order(layout.row_of.data());
   // The rank computes a range of the layout, and writes the index range of its shard.
   const ShardRange range = shard_range(v, index, count);
   const std::size_t per_vertex = engine.floats_per_vertex();
@@ -260,8 +260,7 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
       const std::uint64_t local = begin - range.first;
       hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
       engine.bounce(layout.block(begin, end), hit_blocks,
-                    reinterpret_cast<const float*>(map.data()), layout.row_of.data(),
-                    current.data());
+                    reinterpret_cast<const float*>(map.data()), current.data());
       running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
       // The last pass's sums take the place of M^b: the shard is in index order, and its
@@ -313,6 +312,7 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
     engine.finish_pass();
   } else {
     const Layout layout(mesh);
+    engine.set_row_order(layout.row_of.data());
     auto shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
     HitStore hits(scratch_target(path, "hits"));
     std::vector<HitBlock> hit_blocks;
