@@ -36,8 +36,14 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
   result.basis = Eigen::MatrixXd::Zero(k, n);
   result.eigenvalues = Eigen::VectorXd::Zero(k);
   // A is the smaller of F^T F (n x n) and F F^T (m x m); both share the non-zero spectrum.
-  Eigen::MatrixXd a =
-      result.gram ? Eigen::MatrixXd(f * f.transpose()) : Eigen::MatrixXd(f.transpose() * f);
+  // Only its lower triangle is formed and read: a rank update costs half the product, and
+  // the symmetric matrix-vector product reads A once for both triangles. On a cluster larger
+  // than the dimension these two are nearly all of the PCA's time.
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(std::min(m, n), std::min(m, n));
+  if (result.gram)
+    a.selfadjointView<Eigen::Lower>().rankUpdate(f);
+  else
+    a.selfadjointView<Eigen::Lower>().rankUpdate(f.transpose());
   const double scale = a.trace();
   if (!(scale > 0.0)) return result;  // all points equal the mean: nothing to find
   std::uint64_t state = options.seed;
@@ -48,7 +54,7 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
     double lambda = 0.0, previous_change = std::numeric_limits<double>::infinity();
     for (int it = 0; it < options.max_iterations; ++it) {
       ++result.iterations;
-      next.noalias() = a * v;
+      next.noalias() = a.selfadjointView<Eigen::Lower>() * v;
       lambda = next.norm();
       if (!(lambda > 1e-12 * scale)) {  // the remaining spectrum is rounding noise
         lambda = 0.0;
@@ -64,7 +70,7 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
     }
     if (lambda == 0.0) break;  // rows p..k-1 stay zero
     result.eigenvalues[p] = lambda;
-    a.noalias() -= lambda * v * v.transpose();
+    a.selfadjointView<Eigen::Lower>().rankUpdate(v, -lambda);
     Eigen::RowVectorXd direction = result.gram ? Eigen::RowVectorXd((f.transpose() * v).transpose())
                                                : Eigen::RowVectorXd(v.transpose());
     // v is a left singular vector u on the Gram path; the principal direction is F^T u /
