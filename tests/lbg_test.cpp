@@ -234,4 +234,20 @@ TEST(SplitEmptyClusters, FillsEveryClusterAndLowersEnergy) {
   EXPECT_LT(cpca::clustering_energy(x, all_zero, cpca::cluster_means(x, all_zero, 4)), before);
 }
 
+TEST(SplitEmptyClusters, ALargeClusterSplitsBetweenItsTwoBlobs) {
+  // 6000 rows in one cluster, more than the split's sample: the direction comes from the
+  // sample, and every row, sampled or not, must land on its blob's side.
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.f, 0.3f);
+  cpca::DataMatrix x(6000, 8);
+  for (Eigen::Index i = 0; i < x.rows(); ++i)
+    for (Eigen::Index d = 0; d < x.cols(); ++d)
+      x(i, d) = noise(rng) + (i % 2 == 0 ? 4.f : -4.f) * float(d == 3);
+  std::vector<std::uint32_t> cluster_of(6000, 0);
+  EXPECT_EQ(cpca::split_empty_clusters(x, cluster_of, 2), 1);
+  for (Eigen::Index i = 2; i < x.rows(); ++i)
+    ASSERT_EQ(cluster_of[std::size_t(i)], cluster_of[std::size_t(i % 2)]) << "row " << i;
+  EXPECT_NE(cluster_of[0], cluster_of[1]);
+}
+
 }  // namespace

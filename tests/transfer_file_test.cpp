@@ -2,6 +2,8 @@
 // kind of damage, and the byte offsets that docs/FORMATS.md promises to NumPy users.
 #include "prt/transfer_file.h"
 
+#include "prt/mapped_transfer.h"
+
 #include "common/atomic_file.h"
 #include "common/hash.h"
 
@@ -192,6 +194,26 @@ TEST(TransferFile, HeaderOnlyReadSkipsPayload) {
   fs::resize_file(p, fs::file_size(p) - 4);
   error_of(
       p, [](const fs::path& q) { prt::read_transfer_header(q); }, "truncated: expected");
+}
+
+TEST(TransferFile, MappedRowsReadAsTheyWereWritten) {
+  const TransferSet set = make_set(TransferKind::kGlossy, 3, 3, 50, prt::MaterialKind::kPhong, 12);
+  const fs::path p = scratch("mapped_rows.prtx");
+  prt::write_transfer(p, set);
+  const prt::MappedTransfer mapped(p);
+  const std::size_t row = set.floats_per_vertex();
+  // Runs (3 4 5, 48 49) read as one pread each, single rows, a repeat and the last row.
+  const std::vector<std::uint32_t> rows = {3, 4, 5, 0, 48, 49, 17, 17, 2};
+  std::vector<float> out(rows.size() * row, -1.f);
+  mapped.read_rows(rows.data(), rows.size(), out.data());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_TRUE(std::equal(out.begin() + std::ptrdiff_t(i * row),
+                           out.begin() + std::ptrdiff_t((i + 1) * row),
+                           set.data.begin() + std::ptrdiff_t(rows[i] * row)));
+  }
+  const std::uint32_t past = 50;
+  EXPECT_THROW(mapped.read_rows(&past, 1, out.data()), common::IoError);
 }
 
 // --- The documented layout, read the way docs/FORMATS.md's NumPy snippet reads it ----------

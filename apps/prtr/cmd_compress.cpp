@@ -130,16 +130,21 @@ void print_report(const Options& o, const cpca::CompressedSet& set,
     print_text(o, set, report, sizes);
 }
 
-// The mapped payload as rows in blocks, each block's pages released after a pass.
+// The mapped payload as rows in blocks, each block's pages released after a pass; scattered
+// rows (a cluster's members) are read, not mapped.
 cpca::RowBlocks row_blocks(const prt::MappedTransfer& mapped, std::uint64_t block_vertices) {
   const prt::TransferSet& transfer = mapped.header();
   const Eigen::Map<const cpca::DataMatrix> rows(mapped.payload(),
                                                 Eigen::Index(transfer.vertex_count),
                                                 Eigen::Index(transfer.floats_per_vertex()));
-  return cpca::RowBlocks(rows, block_rows(transfer, block_vertices),
-                         [&mapped](Eigen::Index first, Eigen::Index count) {
-                           mapped.release(std::uint64_t(first), std::uint64_t(count));
-                         });
+  return cpca::RowBlocks(
+      rows, block_rows(transfer, block_vertices),
+      [&mapped](Eigen::Index first, Eigen::Index count) {
+        mapped.release(std::uint64_t(first), std::uint64_t(count));
+      },
+      [&mapped](const std::uint32_t* which, Eigen::Index count, float* out) {
+        mapped.read_rows(which, std::size_t(count), out);
+      });
 }
 
 // Under mpirun: every rank maps the .prtx and runs its share of LBG and the PCA

@@ -14,7 +14,7 @@
 
 namespace common {
 
-MappedFile::MappedFile(const std::filesystem::path& path) {
+MappedFile::MappedFile(const std::filesystem::path& path) : path_(path.string()) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     throw IoError(path.string() + ": cannot open for mapping (" + std::strerror(errno) + ")");
@@ -35,11 +35,18 @@ MappedFile::MappedFile(const std::filesystem::path& path) {
     }
     data_ = static_cast<const unsigned char*>(p);
   }
-  ::close(fd);  // the mapping keeps the file open
+  fd_ = fd;  // kept for read()
 }
 
 MappedFile::~MappedFile() {
   if (data_) ::munmap(const_cast<unsigned char*>(data_), size_);
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void MappedFile::read(std::size_t offset, void* out, std::size_t bytes) const {
+  if (offset > size_ || bytes > size_ - offset)
+    throw IoError(path_ + ": read past the end of the mapped file");
+  read_exact(fd_, out, bytes, offset, path_.c_str());
 }
 
 void MappedFile::release(std::size_t offset, std::size_t bytes) const {

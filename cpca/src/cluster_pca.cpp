@@ -15,11 +15,23 @@
 namespace cpca {
 namespace {
 
-// `after_cluster` runs once a cluster's rows have been gathered and used, so an out-of-core
-// source can drop the pages the gather touched.
-std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
-                                 PcaSolver solver, const PowerIterationOptions& power,
-                                 ClusterPcaStats* stats, const std::function<void()>& after_cluster,
+// Rows `m` of x, kGranule at a time through RowBlocks::gather: f(i, row) for member i.
+template <class F>
+void for_each_member_row(const RowBlocks& x, const std::vector<std::uint32_t>& m, F&& f) {
+  constexpr Eigen::Index kRows = RowBlocks::kGranule;
+  const Eigen::Index rows = Eigen::Index(m.size());
+  DataMatrix block(std::min(kRows, rows), x.cols());
+  for (Eigen::Index begin = 0; begin < rows; begin += kRows) {
+    const Eigen::Index n = std::min(kRows, rows - begin);
+    x.gather(m.data() + begin, n, block.data());
+    for (Eigen::Index i = 0; i < n; ++i) f(begin + i, block.row(i));
+  }
+}
+
+// A cluster's rows come through RowBlocks::gather, so an out-of-core source keeps no pages
+// of them resident.
+std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
+                                 const PowerIterationOptions& power, ClusterPcaStats* stats,
                                  const std::function<bool(int)>& fits = {}) {
   const int k = set.cluster_count, n = set.component_count;
   const Eigen::Index d = x.cols();
@@ -43,7 +55,8 @@ std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, Compress
     if (m.empty() || (fits && !fits(c))) return;
     const Eigen::Index rows = Eigen::Index(m.size());
     Eigen::MatrixXd f(rows, d);
-    for (Eigen::Index i = 0; i < rows; ++i) f.row(i) = x.row(m[std::size_t(i)]).cast<double>();
+    for_each_member_row(
+        x, m, [&](Eigen::Index i, const auto& row) { f.row(i) = row.template cast<double>(); });
     const Eigen::RowVectorXd mean = f.colwise().mean();
     f.rowwise() -= mean;
     Eigen::Map<Eigen::RowVectorXf>(set.means.data() + std::size_t(c) * std::size_t(d), d) =
@@ -64,17 +77,16 @@ std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, Compress
     const Eigen::MatrixXd b = stored.cast<double>();
     const Eigen::MatrixXd w = f * b.transpose();  // rows x n
     const Eigen::RowVectorXd mean_f = mean.cast<float>().cast<double>();
-    for (Eigen::Index i = 0; i < rows; ++i) {
+    for_each_member_row(x, m, [&](Eigen::Index i, const auto& row) {
       const std::uint32_t p = m[std::size_t(i)];
       for (int j = 0; j < n; ++j)
         set.weights[std::size_t(p) * std::size_t(n) + std::size_t(j)] = float(w(i, j));
       const Eigen::RowVectorXd wf = Eigen::Map<const Eigen::RowVectorXf>(
                                         set.weights.data() + std::size_t(p) * std::size_t(n), n)
                                         .cast<double>();
-      const Eigen::RowVectorXd residual = x.row(p).cast<double>() - mean_f - wf * b;
+      const Eigen::RowVectorXd residual = row.template cast<double>() - mean_f - wf * b;
       error[p] = residual.squaredNorm();
-    }
-    if (after_cluster) after_cluster();
+    });
   });
   if (stats) stats->power_iterations = iterations;
   return error;
@@ -85,12 +97,12 @@ std::vector<double> fit_clusters(const Eigen::Ref<const DataMatrix>& x, Compress
 std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                     PcaSolver solver, const PowerIterationOptions& power,
                                     ClusterPcaStats* stats) {
-  return fit_clusters(x, set, solver, power, stats, {});
+  return fit_clusters(RowBlocks(x), set, solver, power, stats);
 }
 
 std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
                                     const PowerIterationOptions& power, ClusterPcaStats* stats) {
-  return fit_clusters(x.all(), set, solver, power, stats, [&x] { x.release_all(); });
+  return fit_clusters(x, set, solver, power, stats);
 }
 
 namespace {
@@ -162,9 +174,8 @@ std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaS
                                     Distribution& dist) {
   const int rank = dist.rank(), ranks = dist.size();
   ClusterPcaStats own;
-  std::vector<double> error = fit_clusters(
-      x.all(), set, solver, power, &own, [&x] { x.release_all(); },
-      [&](int c) { return c % ranks == rank; });
+  std::vector<double> error =
+      fit_clusters(x, set, solver, power, &own, [&](int c) { return c % ranks == rank; });
   if (ranks > 1) {
     // Every rank holds the same ids, so rank 0 knows the layout of every share.
     const auto members = cluster_members(set.cluster_of, set.cluster_count);

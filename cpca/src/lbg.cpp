@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -168,10 +167,23 @@ double clustering_energy(const Eigen::Ref<const DataMatrix>& x,
 
 namespace {
 
-// `after_gather` runs once the largest cluster's rows are copied, so an out-of-core source
-// can drop the pages the gather touched before the next split gathers again.
-int split_clusters(const Eigen::Ref<const DataMatrix>& x, std::vector<std::uint32_t>& cluster_of,
-                   int cluster_count, const std::function<void()>& after_gather) {
+// The split needs a direction of large spread, not the exact principal axis: a strided
+// sample of at most kSplitSample members finds it in cache, and one pass over all members
+// then classifies them. Gathering the whole cluster and iterating over it cost a third of
+// LBG's time on a 557 k-vertex bake, where the first splits halve clusters of 10^5 rows.
+constexpr Eigen::Index kSplitSample = 2048;
+
+// (x - mean) . dir in double, summed in column order: the same bits for a row wherever it
+// lives (in memory or in a map at another alignment) and whichever thread computes it.
+double offset_along(const float* x, const Eigen::VectorXd& mean, const Eigen::VectorXd& dir) {
+  double s = 0.0;
+  for (Eigen::Index c = 0; c < dir.size(); ++c) s += (double(x[c]) - mean[c]) * dir[c];
+  return s;
+}
+
+// The members' rows come through gather(), a block at a time, so a split of an
+// out-of-core cluster keeps neither the cluster nor its pages resident.
+int split_clusters(const RowBlocks& x, std::vector<std::uint32_t>& cluster_of, int cluster_count) {
   if (Eigen::Index(cluster_count) > x.rows())
     throw std::invalid_argument("cannot form " + std::to_string(cluster_count) + " clusters from " +
                                 std::to_string(x.rows()) +
@@ -188,28 +200,39 @@ int split_clusters(const Eigen::Ref<const DataMatrix>& x, std::vector<std::uint3
     for (std::size_t p = 0; p < cluster_of.size(); ++p)
       if (cluster_of[p] == largest) members.push_back(std::uint32_t(p));
     const Eigen::Index m = Eigen::Index(members.size());
-    Eigen::MatrixXf centred(m, x.cols());
-    for (Eigen::Index i = 0; i < m; ++i) centred.row(i) = x.row(members[std::size_t(i)]);
-    if (after_gather) after_gather();
-    const Eigen::RowVectorXf mean = centred.colwise().mean();
-    centred.rowwise() -= mean;
+    const Eigen::Index s = std::min(m, kSplitSample);
+    std::vector<std::uint32_t> picked(static_cast<std::size_t>(s));
+    for (Eigen::Index i = 0; i < s; ++i) picked[std::size_t(i)] = members[std::size_t(i * m / s)];
+    DataMatrix sample(s, x.cols());
+    x.gather(picked.data(), s, sample.data());
+    const Eigen::RowVectorXf mean = sample.colwise().mean();
+    sample.rowwise() -= mean;
     // Principal direction by power iteration, started from the farthest point's offset
     // (deterministic, and already close to the direction of largest spread).
     Eigen::Index far = 0;
-    centred.rowwise().squaredNorm().maxCoeff(&far);
-    Eigen::VectorXf dir = centred.row(far).transpose();
+    sample.rowwise().squaredNorm().maxCoeff(&far);
+    Eigen::VectorXf dir = sample.row(far).transpose();
     Eigen::VectorXf proj;
     for (int it = 0; it < 6 && dir.squaredNorm() > 0; ++it) {
-      proj.noalias() = centred * dir;
-      dir.noalias() = centred.transpose() * proj;
+      proj.noalias() = sample * dir;
+      dir.noalias() = sample.transpose() * proj;
       const float norm = dir.norm();
       if (!(norm > 0)) break;
       dir /= norm;
     }
-    proj.noalias() = centred * dir;
+    const Eigen::VectorXd mean_d = mean.transpose().cast<double>(), dir_d = dir.cast<double>();
+    std::vector<char> positive(members.size());
+    constexpr Eigen::Index kRows = RowBlocks::kGranule;
+    tbb::parallel_for(Eigen::Index(0), (m + kRows - 1) / kRows, [&](Eigen::Index b) {
+      const Eigen::Index begin = b * kRows, rows = std::min(kRows, m - begin);
+      DataMatrix block(rows, x.cols());
+      x.gather(members.data() + begin, rows, block.data());
+      for (Eigen::Index i = 0; i < rows; ++i)
+        positive[std::size_t(begin + i)] = offset_along(&block(i, 0), mean_d, dir_d) > 0;
+    });
     std::vector<std::uint32_t> moved;
     for (Eigen::Index i = 0; i < m; ++i)
-      if (proj[i] > 0) moved.push_back(members[std::size_t(i)]);
+      if (positive[std::size_t(i)]) moved.push_back(members[std::size_t(i)]);
     if (moved.empty() || moved.size() == members.size()) {
       // No spread along any direction (identical points): move half of them.
       moved.assign(members.begin() + m / 2, members.end());
@@ -226,12 +249,12 @@ int split_clusters(const Eigen::Ref<const DataMatrix>& x, std::vector<std::uint3
 
 int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
                          std::vector<std::uint32_t>& cluster_of, int cluster_count) {
-  return split_clusters(x, cluster_of, cluster_count, {});
+  return split_clusters(RowBlocks(x), cluster_of, cluster_count);
 }
 
 int split_empty_clusters(const RowBlocks& x, std::vector<std::uint32_t>& cluster_of,
                          int cluster_count) {
-  return split_clusters(x.all(), cluster_of, cluster_count, [&x] { x.release_all(); });
+  return split_clusters(x, cluster_of, cluster_count);
 }
 
 namespace {

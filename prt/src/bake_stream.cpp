@@ -106,8 +106,8 @@ struct Layout {
 
 // The rows of `rows` (a pass of every vertex in layout order) of vertices [first, last),
 // appended to `append` in index order, `block` vertices at a time. Read row by row rather
-// than mapped: the reads jump through the file, and a map's fault-around would make each
-// 5 KB row cost 64 KB of resident pages.
+// than mapped: the reads jump through the file, and a fault maps a whole page-cache folio
+// (up to megabytes), far more resident memory than the 5 KB row.
 template <class Rows>
 void append_in_index_order(const Rows& rows, const Layout& layout, std::uint64_t first,
                            std::uint64_t last, std::size_t per_vertex, std::uint64_t block,

@@ -44,6 +44,17 @@ const float* MappedTransfer::payload() const {
   return reinterpret_cast<const float*>(file_.data() + kTransferHeaderBytes);
 }
 
+void MappedTransfer::read_rows(const std::uint32_t* rows, std::size_t count, float* out) const {
+  const std::uint64_t row = header_.floats_per_vertex() * sizeof(float);
+  for (std::size_t i = 0; i < count;) {
+    std::size_t run = 1;
+    while (i + run < count && rows[i + run] == rows[i] + run) ++run;
+    file_.read(kTransferHeaderBytes + rows[i] * row, out + i * header_.floats_per_vertex(),
+               run * row);
+    i += run;
+  }
+}
+
 void MappedTransfer::release(std::uint64_t first, std::uint64_t count) const {
   const std::uint64_t row = header_.floats_per_vertex() * sizeof(float);
   file_.release(kTransferHeaderBytes + first * row, count * row);

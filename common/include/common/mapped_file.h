@@ -2,12 +2,15 @@
 // memory a process should hold (a streaming bake's previous pass, a .prtx being compressed).
 // Pages come from the page cache on first touch; release() drops this process's mappings of
 // them so its resident set stays bounded by what it touched since, while the kernel keeps
-// the pages cached for a cheap re-fault.
+// the pages cached for a cheap re-fault. Scattered small reads should use read() instead: a
+// fault maps a whole page-cache folio (up to megabytes on file systems with large folios), so
+// touching one 5 KB row through the map can make a megabyte resident.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 
 namespace common {
 
@@ -25,8 +28,12 @@ class MappedFile {
   // inside the range); their contents stay readable.
   void release(std::size_t offset, std::size_t bytes) const;
   void release() const { release(0, size_); }
+  // Copies [offset, offset + bytes) with pread, leaving the mapping untouched. Throws IoError.
+  void read(std::size_t offset, void* out, std::size_t bytes) const;
 
  private:
+  std::string path_;
+  int fd_ = -1;
   const unsigned char* data_ = nullptr;
   std::size_t size_ = 0;
 };

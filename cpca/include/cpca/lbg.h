@@ -5,7 +5,8 @@
 //  1. Assign every point to its nearest mean (distances as matrix products, assignment.h), or
 //     with geometry coherence when one is given.
 //  -  Null-cluster avoidance: while a cluster is empty, split the most populated cluster in two
-//     along its principal direction (a few power iterations) and give one half to the empty one.
+//     along its principal direction (a few power iterations on a strided sample of at most
+//     2048 of its points) and give the half on one side to the empty one.
 //  2. Update every mean to the average of its points.
 //  3. Energy E_i = sum_p ||x_p - mean||^2 (eq. 4); stop when E_i = 0 or the converged ratio
 //     (E_{i-1} - E_i) / E_{i-1} (eq. 5) falls below the threshold in magnitude (with geometry
@@ -58,11 +59,12 @@ LbgResult lbg(const RowBlocks& x, const LbgOptions& options, Distribution& distr
               const LbgCallback& callback = {});
 
 // Fills every empty cluster (ids < cluster_count) by splitting the most populated one along
-// its principal direction. Returns the number of splits. Throws std::invalid_argument when
-// there are more clusters than points.
+// its principal direction (estimated from a strided sample of at most 2048 members; every
+// member is then classified by its side). Returns the number of splits. Throws
+// std::invalid_argument when there are more clusters than points.
 int split_empty_clusters(const Eigen::Ref<const DataMatrix>& x,
                          std::vector<std::uint32_t>& cluster_of, int cluster_count);
-// The same, releasing the source's pages after each split's gather of the largest cluster.
+// The same, reading the largest cluster's rows through RowBlocks::gather.
 int split_empty_clusters(const RowBlocks& x, std::vector<std::uint32_t>& cluster_of,
                          int cluster_count);
 

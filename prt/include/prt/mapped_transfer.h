@@ -24,6 +24,10 @@ class MappedTransfer {
   const float* payload() const;
   // Drops the pages of vertices [first, first + count) from this process (see MappedFile).
   void release(std::uint64_t first, std::uint64_t count) const;
+  // Copies the rows of vertices rows[0..count) to out (count x floats_per_vertex floats) with
+  // pread, runs of consecutive vertices in one read: random access that leaves no pages
+  // resident (see MappedFile::read).
+  void read_rows(const std::uint32_t* rows, std::size_t count, float* out) const;
 
  private:
   TransferSet header_;
