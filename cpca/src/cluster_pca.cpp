@@ -76,17 +76,19 @@ std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolv
     stored = basis.cast<float>();
     const Eigen::MatrixXd b = stored.cast<double>();
     const Eigen::MatrixXd w = f * b.transpose();  // rows x n
-    const Eigen::RowVectorXd mean_f = mean.cast<float>().cast<double>();
-    for_each_member_row(x, m, [&](Eigen::Index i, const auto& row) {
+    // The residual against the stored (float) mean, from the centred rows already in f:
+    // x - mean_f = f + (mean - mean_f), without reading the cluster a second time.
+    const Eigen::RowVectorXd mean_shift = mean - mean.cast<float>().cast<double>();
+    for (Eigen::Index i = 0; i < rows; ++i) {
       const std::uint32_t p = m[std::size_t(i)];
       for (int j = 0; j < n; ++j)
         set.weights[std::size_t(p) * std::size_t(n) + std::size_t(j)] = float(w(i, j));
       const Eigen::RowVectorXd wf = Eigen::Map<const Eigen::RowVectorXf>(
                                         set.weights.data() + std::size_t(p) * std::size_t(n), n)
                                         .cast<double>();
-      const Eigen::RowVectorXd residual = row.template cast<double>() - mean_f - wf * b;
+      const Eigen::RowVectorXd residual = f.row(i) + mean_shift - wf * b;
       error[p] = residual.squaredNorm();
-    });
+    }
   });
   if (stats) stats->power_iterations = iterations;
   return error;
