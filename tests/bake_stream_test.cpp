@@ -42,8 +42,9 @@ std::size_t files_in(const fs::path& dir) {
   return n;
 }
 
-void expect_same_file(const meshes::Mesh& mesh, const prt::BakeOptions& o, std::uint64_t block,
-                      const std::string& name) {
+// Returns the streaming bake's rows_gathered.
+std::uint64_t expect_same_file(const meshes::Mesh& mesh, const prt::BakeOptions& o,
+                               std::uint64_t block, const std::string& name) {
   // A directory per case: ctest runs cases in parallel, and this one counts its files.
   const fs::path whole = test_support::scratch("bake_stream_" + name, "whole.prtx");
   const fs::path streamed = test_support::scratch("bake_stream_" + name, "streamed.prtx");
@@ -54,14 +55,16 @@ void expect_same_file(const meshes::Mesh& mesh, const prt::BakeOptions& o, std::
   EXPECT_EQ(shape.vertex_count, mesh.vertex_count());
   EXPECT_TRUE(shape.data.empty());
   const std::string a = test_support::slurp(whole), b = test_support::slurp(streamed);
-  ASSERT_EQ(a.size(), b.size()) << name;
+  EXPECT_EQ(a.size(), b.size()) << name;
   EXPECT_TRUE(a == b) << name << ": block " << block << " differs from the whole-mesh bake";
   // Only the output appeared: the scratch passes are gone.
   EXPECT_EQ(files_in(streamed.parent_path()), before + 1) << name;
   EXPECT_EQ(stream_stats.rays_shadow, whole_stats.rays_shadow);
   EXPECT_EQ(stream_stats.rays_bounce, whole_stats.rays_bounce);
   EXPECT_EQ(stream_stats.occluded_vertices, whole_stats.occluded_vertices);
+  EXPECT_EQ(whole_stats.rows_gathered, 0u);
   fs::remove(streamed);
+  return stream_stats.rows_gathered;
 }
 
 TEST(StreamingBake, GlossyOneBounceEqualsTheWholeBakeForEveryBlockSize) {
@@ -76,6 +79,25 @@ TEST(StreamingBake, GlossyOneBounceEqualsTheWholeBakeForEveryBlockSize) {
 TEST(StreamingBake, DiffuseTwoBouncesEqualTheWholeBake) {
   // Two bounces exercise the running sum kept on disk between passes.
   expect_same_file(torus(), small_options(prt::TransferKind::kDiffuse, 2), 37, "diffuse2");
+}
+
+TEST(StreamingBake, ABounceCacheSmallerThanThePassKeepsTheBits) {
+  // The bounces read the previous pass through a cache of prt::kGatherBlocks blocks of rows.
+  // 2,048 vertices: with blocks of 64 the cache holds 512 rows, so groups of several chunks
+  // evict rows and read them again; with blocks of 4 it holds 32, fewer than one chunk's
+  // corners, so every group is one chunk and the cache grows to fit it.
+  const meshes::Mesh mesh = meshes::make_torus(1.f, 0.4f, 64, 32);
+  const std::uint64_t v = mesh.vertex_count();
+  const prt::BakeOptions o = small_options(prt::TransferKind::kDiffuse, 2);
+  const std::uint64_t roomy = expect_same_file(mesh, o, 100000, "cache_roomy");
+  const std::uint64_t small = expect_same_file(mesh, o, 64, "cache_small");
+  const std::uint64_t tiny = expect_same_file(mesh, o, 4, "cache_tiny");
+  // A cache that holds the whole pass reads each row at most once a bounce.
+  EXPECT_GT(roomy, 0u);
+  EXPECT_LE(roomy, 2 * v);
+  // Smaller caches read rows again: the bits above are not the roomy cache's by accident.
+  EXPECT_GT(small, roomy);
+  EXPECT_GT(tiny, small);
 }
 
 TEST(StreamingBake, NoBouncesEqualsTheWholeBake) {

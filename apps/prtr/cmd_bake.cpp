@@ -124,6 +124,7 @@ Json summary_json(const meshes::Mesh& mesh, const prt::BakeStats& stats) {
   j["seconds_brdf"] = stats.seconds_brdf;
   j["rays_shadow"] = stats.rays_shadow;
   j["rays_bounce"] = stats.rays_bounce;
+  j["rows_gathered"] = stats.rows_gathered;
   j["occluded_fraction"] = stats.occluded_fraction;
   j["nearly_occluded_vertices"] = stats.occluded_vertices.size();
   j["nearly_occluded_ids"] = first(stats.occluded_vertices);

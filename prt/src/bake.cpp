@@ -3,6 +3,7 @@
 #include "prt/bake.h"
 
 #include "bake_engine.h"
+#include "corner_gather.h"
 #include "meshes/weld.h"
 
 #include "prt/ray_scene.h"
@@ -520,14 +521,17 @@ struct CornerFrame {
   Eigen::Vector3f tangent, bitangent, normal;
 };
 
-// The previous bounce's transfer of every vertex, with its layout.
+// The previous bounce's transfer of the vertices a bounce reads, with its layout.
 struct BounceSource {
-  const float* previous;        // M^{b-1}
-  const std::uint32_t* row_of;  // vertex q is row row_of[q] of previous; null: row q
-  const CornerFrame* frames;    // by row
+  const float* previous;        // M^{b-1}: the whole pass, or the rows gathered (slot_of)
+  const std::uint32_t* row_of;  // vertex q is row row_of[q] of the pass; null: row q
+  const CornerFrame* frames;    // by row of the pass
   std::size_t per_vertex, per_channel;
+  const std::uint32_t* slot_of = nullptr;  // vertex q is row slot_of[q] of previous
   std::size_t row_index(std::uint32_t q) const { return row_of ? row_of[q] : q; }
-  const float* row(std::uint32_t q) const { return previous + row_index(q) * per_vertex; }
+  const float* row(std::uint32_t q) const {
+    return previous + (slot_of ? slot_of[q] : row_index(q)) * per_vertex;
+  }
 };
 
 // Glossy corners emit toward p: the directions back to p seen from each hit triangle's
@@ -594,14 +598,14 @@ void bounce_vertex(const BakeContext& ctx, BounceScratch& s, const BounceSource&
   }
 }
 
-// One interreflection pass over `vertices`: their bounce-b transfer, into dst (row i for
-// vertices[i]), from bounce b - 1's of every vertex (src).
+// One interreflection pass over the chunks [first, last) of `vertices`: their bounce-b
+// transfer, into dst (row i for vertices[i]), from bounce b - 1's of the vertices their hits
+// reach (src).
 void bounce_range(const BakeContext& ctx, BouncePool& pool, const std::vector<HitBlock>& hit_blocks,
-                  const BounceSource& src, VertexList vertices, float* dst,
-                  ProgressReporter& progress) {
+                  const BounceSource& src, VertexList vertices, std::uint64_t first,
+                  std::uint64_t last, float* dst, ProgressReporter& progress) {
   const std::uint64_t count = vertices.size();
-  const std::uint64_t chunks = (count + kChunk - 1) / kChunk;
-  tbb::parallel_for(std::uint64_t(0), chunks, [&](std::uint64_t chunk) {
+  tbb::parallel_for(first, last, [&](std::uint64_t chunk) {
     BounceScratch& s = pool.local();
     const HitBlock& block = hit_blocks[chunk];
     const std::uint64_t begin = chunk * kChunk, end = std::min(count, begin + kChunk);
@@ -641,7 +645,8 @@ struct BakeEngine::State {
   // row order (set_row_order).
   const std::uint32_t* row_of = nullptr;
   std::vector<CornerFrame> frames;
-  std::uint64_t shaded = 0;  // vertices through the shadow pass (a shard's range)
+  std::unique_ptr<CornerGather> gather;  // the bounces that read a pass from a file
+  std::uint64_t shaded = 0;              // vertices through the shadow pass (a shard's range)
 };
 
 namespace {
@@ -694,6 +699,7 @@ std::uint64_t BakeEngine::vertex_count() const {
   return state_->ctx.vertex_count;
 }
 void BakeEngine::start_pass(int pass) {
+  if (state_->gather) state_->gather->clear();  // it holds the pass this one replaces
   state_->progress.start_pass(pass);
 }
 void BakeEngine::finish_pass() {
@@ -726,7 +732,29 @@ void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
   if (st.frames.empty()) set_row_order(nullptr);
   const BounceSource src{previous, st.row_of, st.frames.data(), st.ctx.per_vertex,
                          st.ctx.per_channel};
-  bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, dst, st.progress);
+  bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, 0, hits.size(), dst, st.progress);
+  st.stats.seconds_bounces += seconds_since(start);
+}
+
+void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
+                        const PassReader& read, std::size_t gather_bytes, float* dst) {
+  const auto start = Clock::now();
+  State& st = *state_;
+  if (st.frames.empty()) set_row_order(nullptr);
+  if (!st.gather) {
+    st.gather = std::make_unique<CornerGather>(st.ctx.mesh, st.ctx.per_vertex,
+                                               gather_bytes / (st.ctx.per_vertex * sizeof(float)));
+  }
+  CornerGather& gather = *st.gather;
+  for (std::size_t first = 0; first < hits.size();) {
+    const std::size_t last = gather.collect(hits, first);
+    gather.load(read, st.row_of);
+    BounceSource src{gather.rows(), st.row_of, st.frames.data(), st.ctx.per_vertex,
+                     st.ctx.per_channel};
+    src.slot_of = gather.slot_of();
+    bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, first, last, dst, st.progress);
+    first = last;
+  }
   st.stats.seconds_bounces += seconds_since(start);
 }
 
@@ -753,6 +781,7 @@ void BakeEngine::finish() {
   // Over the rays each vertex kept: a moved vertex's first, discarded trace is not counted.
   const double kept = double(state.shaded) * state.setup.samples;
   st.occluded_fraction = kept > 0 ? occluded / kept : 0.0;
+  st.rows_gathered = state.gather ? state.gather->rows_read() : 0;
   st.seconds_total = seconds_since(state.start);
 }
 

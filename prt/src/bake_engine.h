@@ -6,6 +6,7 @@
 #include "prt/bake.h"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -32,6 +33,10 @@ struct HitBlock {
   std::vector<HitRecord> records;
   std::vector<std::uint32_t> offsets;
 };
+
+// Reads `rows` consecutive rows of a previous pass from row `first` into out; called from
+// worker threads at once.
+using PassReader = std::function<void(std::uint64_t first, std::uint64_t rows, float* out)>;
 
 class BakeEngine {
  public:
@@ -60,6 +65,12 @@ class BakeEngine {
   // gave them for the same list.
   void bounce(VertexList vertices, const std::vector<HitBlock>& hits, const float* previous,
               float* dst);
+  // The same bounce, reading the previous pass through `read` instead of holding it: the rows
+  // that a group of chunks' hits reach are gathered into memory, groups taken so that they
+  // hold about gather_bytes (at least one chunk's), so memory stays bounded whatever the
+  // mesh. Same bits as bounce().
+  void bounce(VertexList vertices, const std::vector<HitBlock>& hits, const PassReader& read,
+              std::size_t gather_bytes, float* dst);
   // Fills the remaining stats (ray counts, flagged vertices, total time).
   void finish();
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace prt {
@@ -134,6 +135,7 @@ std::shared_ptr<Scratch> stream_bounces(detail::BakeEngine& engine, const Layout
                                         std::shared_ptr<Scratch> previous_pass) {
   const std::uint64_t v = engine.vertex_count();
   const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::size_t row_bytes = per_vertex * sizeof(float);
   std::shared_ptr<Scratch> previous_sum = previous_pass;  // S^0 = M^0
   std::vector<float> current(block * per_vertex), sum(block * per_vertex);
   std::vector<HitBlock> hit_blocks;
@@ -141,22 +143,22 @@ std::shared_ptr<Scratch> stream_bounces(detail::BakeEngine& engine, const Layout
     const bool last = b == bounces;
     auto pass = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "bounce"));
     auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
-    const common::MappedFile map(previous_pass->path());
-    const auto* m_previous = reinterpret_cast<const float*>(map.data());
+    const Scratch& previous_rows = *previous_pass;
+    const detail::PassReader read = [&](std::uint64_t first, std::uint64_t rows, float* out) {
+      previous_rows.read(out, rows * row_bytes, first * row_bytes);
+    };
     engine.start_pass(b);
     for (std::uint64_t begin = 0; begin < v; begin += block) {
       const std::uint64_t end = std::min(v, begin + block), n = (end - begin) * per_vertex;
       // Every block but the last has `block` vertices, so the same number of chunks.
       const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
       hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks, m_previous, current.data());
+      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block * row_bytes,
+                    current.data());
       previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
       if (pass) pass->write(current.data(), n * sizeof(float));
       running->write(sum.data(), n * sizeof(float));
-      // What this block touched of M^{b-1} leaves the resident set; the next block's hits
-      // fault in their own neighbourhood from the page cache.
-      map.release();
     }
     engine.finish_pass();
     previous_pass = pass;
@@ -194,6 +196,11 @@ class SharedPass {
     common::read_exact(fd_, out, bytes, offset, path_.c_str());
   }
   const fs::path& path() const { return path_; }
+  std::uint64_t size() const {
+    struct stat st {};
+    if (::fstat(fd_, &st) != 0) throw common::IoError(path_.string() + ": cannot stat");
+    return std::uint64_t(st.st_size);
+  }
 
  private:
   fs::path path_;
@@ -234,6 +241,7 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
   // The rank computes a range of the layout, and writes the index range of its shard.
   const ShardRange range = shard_range(v, index, count);
   const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::size_t row_bytes = per_vertex * sizeof(float);
   const std::uint64_t block = std::max<std::uint64_t>(
       1, std::min(range.end - range.first,
                   block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex)));
@@ -250,24 +258,26 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
   for (int b = 1; b <= o.bounces; ++b) {
     const bool last = b == o.bounces;
     auto next_running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
-    const common::MappedFile map(passes[(b - 1) % 2].path());
-    if (map.size() < v * per_vertex * sizeof(float))
-      throw common::IoError(passes[(b - 1) % 2].path().string() +
+    const SharedPass& previous = passes[(b - 1) % 2];
+    if (previous.size() < v * row_bytes)
+      throw common::IoError(previous.path().string() +
                             ": shorter than a pass; is the output directory shared by all ranks?");
+    const detail::PassReader read = [&](std::uint64_t first, std::uint64_t rows, float* out) {
+      previous.read(out, rows * row_bytes, first * row_bytes);
+    };
     engine.start_pass(b);
     for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
       const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
       const std::uint64_t local = begin - range.first;
       hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks,
-                    reinterpret_cast<const float*>(map.data()), current.data());
+      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block * row_bytes,
+                    current.data());
       running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
       // The last pass's sums take the place of M^b: the shard is in index order, and its
       // rows come from every rank's range of the layout.
       passes[b % 2].write(last ? sum.data() : current.data(), n, begin * per_vertex);
       if (!last) next_running->write(sum.data(), n * sizeof(float));
-      map.release();
     }
     engine.finish_pass();
     running = next_running;
@@ -283,9 +293,9 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
 }
 
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex) {
-  // ~64 MiB of transfer per block buffer: large enough that a block keeps every thread busy
-  // and amortises a re-fault of its neighbourhood, small against any mesh worth streaming.
-  const std::uint64_t bytes = std::uint64_t(64) << 20;
+  // ~16 MiB of transfer per block buffer: dozens of chunks for the threads, and small beside
+  // the mesh, its ray scene and the bounces' row cache (kGatherBlocks blocks).
+  const std::uint64_t bytes = std::uint64_t(16) << 20;
   const std::uint64_t v = bytes / (floats_per_vertex * sizeof(float));
   return std::max<std::uint64_t>(kChunk, v / kChunk * kChunk);
 }

@@ -91,6 +91,9 @@ struct BakeStats {
   double seconds_shadow = 0, seconds_bounces = 0, seconds_brdf = 0, seconds_total = 0;
   std::uint64_t rays_shadow = 0, rays_bounce = 0;
   double occluded_fraction = 0;
+  // Rows of previous passes that a streaming bake's bounces read into memory (their hits'
+  // corners, a bounded cache's misses); 0 for an in-memory bake, which holds every pass.
+  std::uint64_t rows_gathered = 0;
   // Nearly occluded vertices, ascending. A sound surface rarely has any: they render black,
   // and point at enclosed or broken geometry (or rays that start inside the surface).
   std::vector<std::uint32_t> occluded_vertices;
@@ -108,7 +111,8 @@ TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& options, BakeStats
 // (0: default_block_vertices), so memory holds a block, the mesh and the ray scene but never
 // the whole payload. The file is byte for byte write_transfer(path, bake(mesh, options)).
 // With bounces, the shadow pass and its front hits go to scratch files beside `path` and
-// each bounce reads the previous pass through a memory map (docs/ARCHITECTURE.md, "Scale").
+// each bounce reads the rows of the previous pass that its hits reach into a cache of
+// kGatherBlocks blocks (docs/ARCHITECTURE.md, "Scale").
 // Atomic: nothing is left at `path` (or beside it) unless the bake completes. Returns the
 // header fields (data empty).
 TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& options,
@@ -136,7 +140,10 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
                                    std::uint32_t count, const std::function<void()>& barrier,
                                    std::uint64_t block_vertices = 0, BakeStats* stats = nullptr);
 
-// Vertices per block holding about 64 MiB of transfer (a multiple of 64, at least 64).
+// Vertices per block holding about 16 MiB of transfer (a multiple of 64, at least 64).
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex);
+
+// The bounces' cache of previous-pass rows holds this many blocks' worth of rows.
+inline constexpr std::uint64_t kGatherBlocks = 8;
 
 }  // namespace prt
