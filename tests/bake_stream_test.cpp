@@ -83,15 +83,15 @@ TEST(StreamingBake, DiffuseTwoBouncesEqualTheWholeBake) {
 
 TEST(StreamingBake, ABounceCacheSmallerThanThePassKeepsTheBits) {
   // The bounces read the previous pass through a cache of prt::kGatherBlocks blocks of rows.
-  // 2,048 vertices: with blocks of 64 the cache holds 512 rows, so groups of several chunks
-  // evict rows and read them again; with blocks of 4 it holds 32, fewer than one chunk's
-  // corners, so every group is one chunk and the cache grows to fit it.
+  // 2,048 vertices: with blocks of 512 / kGatherBlocks the cache holds 512 rows, so groups of
+  // dozens of vertices evict rows and read them again; with blocks of 32 / kGatherBlocks it
+  // holds 32, so groups are a vertex or a few (the cache grows if one vertex needs more).
   const meshes::Mesh mesh = meshes::make_torus(1.f, 0.4f, 64, 32);
   const std::uint64_t v = mesh.vertex_count();
   const prt::BakeOptions o = small_options(prt::TransferKind::kDiffuse, 2);
   const std::uint64_t roomy = expect_same_file(mesh, o, 100000, "cache_roomy");
-  const std::uint64_t small = expect_same_file(mesh, o, 64, "cache_small");
-  const std::uint64_t tiny = expect_same_file(mesh, o, 4, "cache_tiny");
+  const std::uint64_t small = expect_same_file(mesh, o, 512 / prt::kGatherBlocks, "cache_small");
+  const std::uint64_t tiny = expect_same_file(mesh, o, 32 / prt::kGatherBlocks, "cache_tiny");
   // A cache that holds the whole pass reads each row at most once a bounce.
   EXPECT_GT(roomy, 0u);
   EXPECT_LE(roomy, 2 * v);

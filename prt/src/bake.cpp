@@ -19,6 +19,7 @@
 #include <atomic>
 #include <chrono>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <numbers>
 #include <numeric>
@@ -267,12 +268,12 @@ namespace {
 
 // What both passes read: the inputs, the shared direction set and the ray scene.
 struct BakeContext {
-  BakeContext(const meshes::Mesh& m, const BakeOptions& o, const Setup& s, const RayScene& r)
+  BakeContext(const meshes::Mesh& m, const BakeOptions& o, const Setup& s, const RayScene* r)
       : mesh(m), options(o), setup(s), scene(r) {}
   const meshes::Mesh& mesh;
   const BakeOptions& options;
   const Setup& setup;
-  const RayScene& scene;
+  const RayScene* scene;  // null once tracing ends (BakeEngine::end_tracing)
   int channels = 0;
   bool glossy = false;
   float offset = 0;  // ray-origin offset in world units
@@ -339,7 +340,7 @@ void ray_origins(const BakeContext& ctx, ShadowScratch& s, std::uint64_t p) {
 // s.occluded_index and their SH values in s.y_occluded, and returns how many there are.
 int trace_from_origins(const BakeContext& ctx, ShadowScratch& s) {
   const Setup& setup = ctx.setup;
-  ctx.scene.occluded_from(s.origins, s.world, 0.f, s.occluded.data());
+  ctx.scene->occluded_from(s.origins, s.world, 0.f, s.occluded.data());
   int k = 0;
   for (int d = 0; d < setup.samples; ++d) {
     if (!s.occluded[d]) continue;
@@ -377,7 +378,7 @@ std::optional<Eigen::Vector3f> escape_origin(const BakeContext& ctx, std::uint64
     const Eigen::Vector3f start = at + f.steps.col(e);
     probes.col(0) = mesh.normals[p];
     probes.col(1) = f.normals.col(e);
-    ctx.scene.intersect(start, probes, 0.f, hits);
+    ctx.scene->intersect(start, probes, 0.f, hits);
     for (int j = 0; j < 2; ++j) {
       const RayHit& h = hits[j];
       if (h.triangle < 0 || !(h.t < best_t)) continue;
@@ -436,8 +437,8 @@ void record_front_hits(const BakeContext& ctx, ShadowScratch& s, int k, HitBlock
     s.occluded_world.col(j) = s.world.col(s.occluded_index[j]);
     s.occluded_origins.col(j) = s.origins.col(s.occluded_index[j]);
   }
-  ctx.scene.intersect_from(s.occluded_origins.leftCols(k), s.occluded_world.leftCols(k), 0.f,
-                           s.hits.data());
+  ctx.scene->intersect_from(s.occluded_origins.leftCols(k), s.occluded_world.leftCols(k), 0.f,
+                            s.hits.data());
   s.rays_bounce += k;
   for (int j = 0; j < k; ++j) {
     const RayHit& h = s.hits[j];
@@ -598,20 +599,21 @@ void bounce_vertex(const BakeContext& ctx, BounceScratch& s, const BounceSource&
   }
 }
 
-// One interreflection pass over the chunks [first, last) of `vertices`: their bounce-b
+// One interreflection pass over the vertices [first, last) of `vertices`: their bounce-b
 // transfer, into dst (row i for vertices[i]), from bounce b - 1's of the vertices their hits
-// reach (src).
+// reach (src). Work is split at chunk boundaries.
 void bounce_range(const BakeContext& ctx, BouncePool& pool, const std::vector<HitBlock>& hit_blocks,
                   const BounceSource& src, VertexList vertices, std::uint64_t first,
                   std::uint64_t last, float* dst, ProgressReporter& progress) {
-  const std::uint64_t count = vertices.size();
-  tbb::parallel_for(first, last, [&](std::uint64_t chunk) {
+  if (first >= last) return;
+  tbb::parallel_for(first / kChunk, (last - 1) / kChunk + 1, [&](std::uint64_t chunk) {
     BounceScratch& s = pool.local();
     const HitBlock& block = hit_blocks[chunk];
-    const std::uint64_t begin = chunk * kChunk, end = std::min(count, begin + kChunk);
+    const std::uint64_t base = chunk * kChunk;
+    const std::uint64_t begin = std::max(first, base), end = std::min(last, base + kChunk);
     for (std::uint64_t i = begin; i < end; ++i) {
-      const std::uint32_t at = block.offsets[i - begin];
-      const int hits = int(block.offsets[i - begin + 1] - at);
+      const std::uint32_t at = block.offsets[i - base];
+      const int hits = int(block.offsets[i - base + 1] - at);
       bounce_vertex(ctx, s, src, block.records.data() + at, hits, vertices[i],
                     dst + i * src.per_vertex);
     }
@@ -627,15 +629,15 @@ struct BakeEngine::State {
   State(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats& st)
       : stats(st),
         setup(make_setup(o, o.material.channels(), &st.seconds_brdf)),
-        scene(mesh),
-        ctx(mesh, o, setup, scene),
+        scene(std::make_unique<RayScene>(mesh)),
+        ctx(mesh, o, setup, scene.get()),
         progress(o.progress, 1 + o.bounces, mesh.vertex_count()),
         shadow_pool([this] { return ShadowScratch(ctx.options.order, setup.n, setup.samples); }),
         bounce_pool([this] { return BounceScratch(setup.n, setup.samples); }) {}
   BakeStats& stats;
   Clock::time_point start = Clock::now();
   Setup setup;
-  RayScene scene;
+  std::unique_ptr<RayScene> scene;
   BakeContext ctx;
   ProgressReporter progress;
   ShadowPool shadow_pool;
@@ -709,9 +711,17 @@ void BakeEngine::finish_pass() {
 void BakeEngine::shadow(VertexList vertices, float* dst, std::vector<HitBlock>* hits) {
   const auto start = Clock::now();
   State& st = *state_;
+  if (!st.scene) throw std::logic_error("BakeEngine::shadow after end_tracing");
   shadow_range(st.ctx, st.shadow_pool, vertices, dst, hits, st.flags, st.progress);
   st.shaded += vertices.size();
   st.stats.seconds_shadow += seconds_since(start);
+}
+
+void BakeEngine::end_tracing() {
+  State& st = *state_;
+  st.ctx.scene = nullptr;
+  st.scene.reset();
+  st.ctx.faces = OriginFaces{};
 }
 
 void BakeEngine::set_row_order(const std::uint32_t* row_of) {
@@ -732,7 +742,7 @@ void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
   if (st.frames.empty()) set_row_order(nullptr);
   const BounceSource src{previous, st.row_of, st.frames.data(), st.ctx.per_vertex,
                          st.ctx.per_channel};
-  bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, 0, hits.size(), dst, st.progress);
+  bounce_range(st.ctx, st.bounce_pool, hits, src, vertices, 0, vertices.size(), dst, st.progress);
   st.stats.seconds_bounces += seconds_since(start);
 }
 
@@ -746,8 +756,8 @@ void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
                                                gather_bytes / (st.ctx.per_vertex * sizeof(float)));
   }
   CornerGather& gather = *st.gather;
-  for (std::size_t first = 0; first < hits.size();) {
-    const std::size_t last = gather.collect(hits, first);
+  for (std::size_t first = 0; first < vertices.size();) {
+    const std::size_t last = gather.collect(hits, first, vertices.size());
     gather.load(read, st.row_of);
     BounceSource src{gather.rows(), st.row_of, st.frames.data(), st.ctx.per_vertex,
                      st.ctx.per_channel};

@@ -57,6 +57,10 @@ class BakeEngine {
   // Shadow pass of `vertices` into dst (vertices.size() x floats_per_vertex, row i for
   // vertices[i]). With bounces, `hits` gets the front hits of each kChunk of them.
   void shadow(VertexList vertices, float* dst, std::vector<HitBlock>* hits);
+  // The shadow pass is done: frees the ray scene and the rays' start points, which the
+  // bounces (reading stored hits) do not need; a streaming bake's bounces then hold the
+  // memory of their row cache instead. shadow() may not be called after it.
+  void end_tracing();
   // The row order every previous pass is stored in for bounce(): vertex q in row row_of[q]
   // (null, the default: row q). row_of must outlive the bounces.
   void set_row_order(const std::uint32_t* row_of);

@@ -251,6 +251,7 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
   HitStore hits(scratch_target(path, "hits"));
   auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
   rank_shadow(engine, layout, range, block, passes[0], *running, hits);
+  engine.end_tracing();
   barrier();  // every rank's M^0 is in passes[0]
   std::vector<float> current(block * per_vertex), sum(block * per_vertex);
   std::vector<HitBlock> hit_blocks;
@@ -333,6 +334,7 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
       hits.store(hit_blocks);
     }
     engine.finish_pass();
+    engine.end_tracing();
     buffer = {};
     // Handed over, so that the shadow pass's scratch is removed as soon as the bounces are
     // done with it, not kept beside the output while it is written.

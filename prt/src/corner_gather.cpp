@@ -31,7 +31,7 @@ namespace {
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t kMaxRun = 64;  // rows per read
 
-}
+}  // namespace
 
 CornerGather::CornerGather(const meshes::Mesh& mesh, std::size_t floats_per_vertex,
                            std::size_t capacity_rows)
@@ -44,7 +44,7 @@ CornerGather::CornerGather(const meshes::Mesh& mesh, std::size_t floats_per_vert
 
 void CornerGather::grow(std::size_t capacity_rows) {
   if (capacity_rows <= capacity_) return;
-  // Only a chunk whose corners outnumber the cache gets here, rarely: start afresh rather
+  // Only a vertex whose corners outnumber the cache gets here (a tiny cache): start afresh rather
   // than hold the old rows and their copy at once.
   clear();
   rows_ = {};
@@ -61,17 +61,19 @@ void CornerGather::clear() {
   }
 }
 
-std::size_t CornerGather::collect(const std::vector<HitBlock>& hits, std::size_t first) {
+std::size_t CornerGather::collect(const std::vector<HitBlock>& hits, std::size_t first,
+                                  std::size_t count) {
   if (++generation_ == 0) {  // wrapped: no stamp may look current
     std::fill(stamp_.begin(), stamp_.end(), 0);
     generation_ = 1;
   }
   group_.clear();
   std::size_t last = first;
-  while (last < hits.size()) {
-    const std::size_t before = group_.size();
-    for (const HitRecord& h : hits[last].records) {
-      for (std::uint32_t q : mesh_.triangles[h.triangle]) {
+  while (last < count) {
+    const HitBlock& block = hits[last / kChunk];
+    const std::size_t i = last % kChunk, before = group_.size();
+    for (std::uint32_t h = block.offsets[i]; h < block.offsets[i + 1]; ++h) {
+      for (std::uint32_t q : mesh_.triangles[block.records[h].triangle]) {
         if (stamp_[q] != generation_) {
           stamp_[q] = generation_;
           group_.push_back(q);
@@ -79,8 +81,8 @@ std::size_t CornerGather::collect(const std::vector<HitBlock>& hits, std::size_t
       }
     }
     if (group_.size() > capacity_ && last > first) {
-      // Over capacity: this chunk waits for the next group, unmarked.
-      for (std::size_t i = before; i < group_.size(); ++i) stamp_[group_[i]] = 0;
+      // Over capacity: this vertex waits for the next group, unmarked.
+      for (std::size_t k = before; k < group_.size(); ++k) stamp_[group_[k]] = 0;
       group_.resize(before);
       break;
     }
@@ -91,7 +93,7 @@ std::size_t CornerGather::collect(const std::vector<HitBlock>& hits, std::size_t
 
 void CornerGather::load(const PassReader& read, const std::uint32_t* row_of) {
   auto row = [row_of](std::uint32_t q) -> std::uint64_t { return row_of ? row_of[q] : q; };
-  grow(group_.size());  // a single chunk larger than the cache
+  grow(group_.size());  // a single vertex larger than the cache
   std::vector<std::uint32_t> missing;
   for (std::uint32_t q : group_) {
     if (slot_of_[q] == kNone) missing.push_back(q);

@@ -1,7 +1,7 @@
 // prt/src/corner_gather.h (private to prt): the rows of a previous pass that a bounce reads,
 // held in a bounded cache, so that a streaming bake's bounce keeps a buffer of fixed size
 // instead of mapping the whole pass (docs/ARCHITECTURE.md, "Scale"). A bounce runs a group of
-// chunks at a time: collect() takes chunks while their hits' corners fit the cache, load()
+// vertices at a time: collect() takes vertices while their hits' corners fit the cache, load()
 // reads the corners not already held, evicting only rows the group does not need. Groups
 // follow the spatial order, so neighbouring groups see the same surfaces and most of a
 // group's rows are still held from the group before.
@@ -29,12 +29,13 @@ struct HugePageAllocator {
 
 class CornerGather {
  public:
-  // A cache of capacity_rows rows (grown when a single chunk needs more).
+  // A cache of capacity_rows rows (grown when a single vertex needs more).
   CornerGather(const meshes::Mesh& mesh, std::size_t floats_per_vertex, std::size_t capacity_rows);
 
-  // Collects the corners of the hits of chunks [first, last), taking chunks from `first` on
-  // while their corners fit the cache (always at least one chunk); returns last.
-  std::size_t collect(const std::vector<HitBlock>& hits, std::size_t first);
+  // Collects the corners of the hits of vertices [first, last) of a list of `count` whose
+  // hits are `hits` (one HitBlock per kChunk of them), taking vertices from `first` on while
+  // their corners fit the cache (always at least one vertex); returns last.
+  std::size_t collect(const std::vector<HitBlock>& hits, std::size_t first, std::size_t count);
   // Makes every collected corner's row of the previous pass resident: reads the missing ones
   // with read() (one call per run of consecutive rows, in parallel; row_of: vertex q's row of
   // the pass, null for row q) into slots freed by rows the group does not need.

@@ -144,6 +144,6 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex);
 
 // The bounces' cache of previous-pass rows holds this many blocks' worth of rows.
-inline constexpr std::uint64_t kGatherBlocks = 8;
+inline constexpr std::uint64_t kGatherBlocks = 16;
 
 }  // namespace prt
