@@ -33,13 +33,12 @@ std::pair<std::uint32_t, std::uint32_t> parse_shard(const std::string& text) {
 }
 
 // The bake with a progress bar; memory is bounded by the block, so no estimate is checked.
-// `mpi_prefix` (under mpirun with bounces) makes the shard one rank of a bake whose passes
-// all ranks share through files beside the output.
+// `rank` (under mpirun) makes it one rank's part of a bake that all ranks write together.
 prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
                              const std::string& output, std::uint64_t block,
                              std::pair<std::uint32_t, std::uint32_t> shard, bool quiet,
-                             prt::BakeStats* stats, const std::string& mpi_prefix = {}) {
-  if (shard.second > 0 && options.bounces > 0 && mpi_prefix.empty()) {
+                             prt::BakeStats* stats, const MpiWorld* rank = nullptr) {
+  if (shard.second > 0 && options.bounces > 0) {
     throw UsageError(
         "--shard needs --bounces 0: an interreflection pass reads every vertex's "
         "previous pass, so bake bounces in one process (it streams, so memory "
@@ -50,9 +49,8 @@ prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
     bar.update(p.pass == 0 ? "shadow pass" : "bounce " + std::to_string(p.pass), p.done, p.total);
   };
   prt::TransferSet set =
-      !mpi_prefix.empty()
-          ? prt::bake_rank_with_bounces(mesh, options, output, mpi_prefix, shard.first,
-                                        shard.second, mpi_barrier, block, stats)
+      rank ? prt::bake_rank(mesh, options, output, std::uint32_t(rank->rank),
+                            std::uint32_t(rank->size), mpi_barrier, block, stats)
       : shard.second > 0
           ? prt::bake_shard_to_file(mesh, options, output, shard.first, shard.second, block, stats)
           : prt::bake_to_file(mesh, options, output, block, stats);
@@ -60,37 +58,31 @@ prt::TransferSet stream_bake(const meshes::Mesh& mesh, prt::BakeOptions options,
   return set;
 }
 
-// Under mpirun: rank r bakes shard r of R beside the output, and once every rank has
-// committed its shard rank 0 merges them into the output (atomically, prt::merge_shards)
-// and deletes them. With bounces, every pass goes through OUT.pass0/.pass1, which each rank
-// writes its slice of and maps whole after a barrier (prt::bake_rank_with_bounces). A rank
-// that fails aborts the whole job before the merge, so nothing appears at the output; a
-// rerun overwrites any shards and pass files left behind.
+// Under mpirun: rank r bakes vertex range r of R and writes its rows straight to their place
+// in OUT.partial (prt::TransferSliceWriter), so nothing is merged; once every rank has
+// closed its slice, rank 0 checksums the payload, writes the header and renames the file over
+// the output (prt::commit_transfer_slices). With bounces, every pass goes through
+// OUT.pass0/.pass1, which each rank writes its slice of and reads after a barrier
+// (prt::bake_rank). A rank that fails aborts the whole job before the commit, so nothing
+// appears at the output; a rerun rewrites the partial and pass files left behind.
 prt::TransferSet mpi_bake(const meshes::Mesh& mesh, const prt::BakeOptions& options,
                           const std::string& output, std::uint64_t block, bool quiet,
                           prt::BakeStats* stats, MpiWorld world) {
-  const std::string passes = options.bounces > 0 ? output : std::string();
-  std::vector<std::filesystem::path> shards;
-  for (int r = 0; r < world.size; ++r)
-    shards.emplace_back(output + ".rank" + std::to_string(r) + "of" + std::to_string(world.size) +
-                        ".prtshard");
   prt::TransferSet set;
   try {
-    set = stream_bake(mesh, options, shards[std::size_t(world.rank)].string(), block,
-                      {std::uint32_t(world.rank), std::uint32_t(world.size)},
-                      quiet || world.rank != 0, stats, passes);
+    set =
+        stream_bake(mesh, options, output, block, {0, 0}, quiet || world.rank != 0, stats, &world);
   } catch (const std::exception& e) {
-    mpi_abort(std::string("bake of its shard failed: ") + e.what());
+    mpi_abort(std::string("bake of its vertex range failed: ") + e.what());
   }
   mpi_barrier();
   if (world.rank == 0) {
     try {
-      prt::merge_shards(shards, output);
-      for (const auto& shard : shards) std::filesystem::remove(shard);
-      if (!passes.empty())
-        for (const char* pass : {".pass0", ".pass1"}) std::filesystem::remove(passes + pass);
+      prt::commit_transfer_slices(output, set);
+      if (options.bounces > 0)
+        for (const char* pass : {".pass0", ".pass1"}) std::filesystem::remove(output + pass);
     } catch (const std::exception& e) {
-      mpi_abort(std::string("merge failed: ") + e.what());
+      mpi_abort(std::string("writing the output failed: ") + e.what());
     }
   }
   mpi_barrier();

@@ -227,27 +227,44 @@ void rank_shadow(detail::BakeEngine& engine, const Layout& layout, const ShardRa
 
 }  // namespace
 
-TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& o,
-                                   const fs::path& path, const fs::path& shared_prefix,
-                                   std::uint32_t index, std::uint32_t count,
-                                   const std::function<void()>& barrier,
-                                   std::uint64_t block_vertices, BakeStats* stats) {
+TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::path& path,
+                      std::uint32_t index, std::uint32_t count,
+                      const std::function<void()>& barrier, std::uint64_t block_vertices,
+                      BakeStats* stats) {
+  if (count == 0 || index >= count) {
+    throw std::invalid_argument("rank " + std::to_string(index) + " of " + std::to_string(count) +
+                                ": needs 0 <= rank < ranks");
+  }
   BakeStats local_stats;
   detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
   const TransferSet shape = engine.shape();
   const std::uint64_t v = engine.vertex_count();
-  const Layout layout(mesh);
-  engine.set_row_order(layout.row_of.data());
-  // The rank computes a range of the layout, and writes the index range of its shard.
   const ShardRange range = shard_range(v, index, count);
   const std::size_t per_vertex = engine.floats_per_vertex();
   const std::size_t row_bytes = per_vertex * sizeof(float);
   const std::uint64_t block = std::max<std::uint64_t>(
       1, std::min(range.end - range.first,
                   block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex)));
-  TransferShardWriter writer(path, shape, range);
-  SharedPass passes[2] = {SharedPass(shared_prefix.string() + ".pass0"),
-                          SharedPass(shared_prefix.string() + ".pass1")};
+  TransferSliceWriter writer(path, shape, range.first, range.end);
+  if (o.bounces == 0) {
+    // Nothing reads another vertex's transfer: the index range, straight to its place.
+    std::vector<float> buffer(block * per_vertex);
+    engine.start_pass(0);
+    for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
+      const std::uint64_t end = std::min(range.end, begin + block);
+      engine.shadow(detail::index_range(begin, end), buffer.data(), nullptr);
+      writer.append(buffer.data(), (end - begin) * per_vertex);
+    }
+    engine.finish_pass();
+    writer.close();
+    engine.finish();
+    return shape;
+  }
+  // Bounces: the rank computes a range of the layout, and writes its index range at the end.
+  const Layout layout(mesh);
+  engine.set_row_order(layout.row_of.data());
+  SharedPass passes[2] = {SharedPass(path.string() + ".pass0"),
+                          SharedPass(path.string() + ".pass1")};
   HitStore hits(scratch_target(path, "hits"));
   auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
   rank_shadow(engine, layout, range, block, passes[0], *running, hits);
@@ -288,7 +305,7 @@ TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& 
   }
   append_in_index_order(passes[o.bounces % 2], layout, range.first, range.end, per_vertex, block,
                         [&](const float* rows, std::size_t n) { writer.append(rows, n); });
-  writer.commit();
+  writer.close();
   engine.finish();
   return shape;
 }

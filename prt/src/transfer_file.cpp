@@ -11,7 +11,9 @@
 #include "common/atomic_file.h"
 #include "common/binary_file.h"
 #include "common/hash.h"
+#include "common/mapped_file.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -23,8 +25,10 @@
 #include <string>
 #include <system_error>
 #include <type_traits>
+#include <vector>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace prt {
@@ -409,6 +413,121 @@ void TransferFileWriter::commit() {
   }
   ::close(fd);
   file_->commit();  // its fsync covers the header written through the second descriptor
+}
+
+fs::path partial_transfer_path(const fs::path& path) {
+  return path.parent_path() / (path.filename().string() + ".partial");
+}
+
+TransferSliceWriter::TransferSliceWriter(const fs::path& path, const TransferSet& shape,
+                                         std::uint64_t first_vertex, std::uint64_t end_vertex)
+    : shape_(without_payload(shape)), partial_(partial_transfer_path(path)) {
+  const auto refuse = [&](const std::string& problem) {
+    return std::invalid_argument(path.string() + ": cannot write the transfer set: " + problem);
+  };
+  if (const std::string problem = field_problem(fields_of(shape_)); !problem.empty())
+    throw refuse(problem);
+  std::uint64_t total = 0;
+  if (!payload_floats_of(shape_.vertex_count, shape_.floats_per_vertex(), &total))
+    throw refuse("vertex count " + std::to_string(shape_.vertex_count) + " is too large");
+  if (first_vertex > end_vertex || end_vertex > shape_.vertex_count)
+    throw refuse("vertex range [" + std::to_string(first_vertex) + ", " +
+                 std::to_string(end_vertex) + ") is outside the mesh");
+  first_float_ = first_vertex * shape_.floats_per_vertex();
+  expected_ = (end_vertex - first_vertex) * shape_.floats_per_vertex();
+  // No O_TRUNC: the other writers may have written their slices already.
+  fd_ = ::open(partial_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    throw common::IoError(partial_.string() + ": cannot open the shared partial file (" +
+                          std::strerror(errno) + ")");
+  }
+}
+
+TransferSliceWriter::~TransferSliceWriter() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void TransferSliceWriter::append(const float* data, std::size_t floats) {
+  if (floats > expected_ - written_) {
+    throw std::invalid_argument(partial_.string() + ": cannot write the transfer set: more than " +
+                                std::to_string(expected_) + " floats appended to the slice");
+  }
+  for (std::size_t i = 0; i < floats; ++i) {
+    if (!std::isfinite(data[i])) {
+      throw std::invalid_argument(
+          partial_.string() + ": cannot write the transfer set: non-finite value " + num(data[i]) +
+          " at " + locate(shape_, first_float_ + written_ + i));
+    }
+  }
+  const auto* p = reinterpret_cast<const unsigned char*>(data);
+  std::size_t left = floats * sizeof(float);
+  off_t at = off_t(kHeaderBytes + (first_float_ + written_) * sizeof(float));
+  while (left > 0) {
+    const ssize_t n = ::pwrite(fd_, p, left, at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      throw common::IoError(partial_.string() + ": write failed (" +
+                            std::string(n < 0 ? std::strerror(errno) : "disk full?") + ")");
+    }
+    p += n;
+    at += n;
+    left -= std::size_t(n);
+  }
+  written_ += floats;
+}
+
+void TransferSliceWriter::close() {
+  if (written_ != expected_) {
+    throw std::invalid_argument(
+        partial_.string() + ": cannot write the transfer set: " + std::to_string(written_) +
+        " of the slice's " + std::to_string(expected_) + " floats were appended");
+  }
+  const int fd = fd_;
+  fd_ = -1;
+  if (::fsync(fd) != 0 || ::close(fd) != 0)
+    throw common::IoError(partial_.string() + ": cannot flush (" + std::strerror(errno) + ")");
+}
+
+void commit_transfer_slices(const fs::path& path, const TransferSet& shape) {
+  const fs::path partial = partial_transfer_path(path);
+  std::uint64_t floats = 0;
+  if (!payload_floats_of(shape.vertex_count, shape.floats_per_vertex(), &floats))
+    throw std::invalid_argument(path.string() + ": too many vertices");
+  const int fd = ::open(partial.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) {
+    throw TransferFileError(partial.string() + ": cannot open the partial file (" +
+                            std::strerror(errno) + "); did every process see this directory?");
+  }
+  try {
+    const std::uint64_t bytes = kHeaderBytes + floats * sizeof(float);
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || std::uint64_t(st.st_size) < bytes) {
+      throw TransferFileError(partial.string() +
+                              ": shorter than the payload; did every process "
+                              "write its slice to the same directory?");
+    }
+    std::uint64_t hash = common::kFnvOffset;
+    std::vector<unsigned char> buffer(std::size_t(16) << 20);
+    for (std::uint64_t at = kHeaderBytes; at < bytes; at += buffer.size()) {
+      const std::size_t n = std::size_t(std::min<std::uint64_t>(buffer.size(), bytes - at));
+      common::read_exact(fd, buffer.data(), n, at, partial.c_str());
+      hash = common::fnv1a(buffer.data(), n, hash);
+    }
+    const Header h = encode_header(without_payload(shape), floats, hash);
+    if (::pwrite(fd, h.data(), h.size(), 0) != static_cast<ssize_t>(h.size()) ||
+        ::ftruncate(fd, off_t(bytes)) != 0 || ::fsync(fd) != 0) {
+      throw common::IoError(partial.string() + ": cannot write the header (" +
+                            std::strerror(errno) + ")");
+    }
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
+  if (::rename(partial.c_str(), path.c_str()) != 0) {
+    throw common::IoError(path.string() + ": cannot replace the file (" + std::strerror(errno) +
+                          ")");
+  }
 }
 
 std::array<unsigned char, kTransferHeaderBytes> encode_transfer_header(

@@ -127,18 +127,18 @@ TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& opti
                                std::uint32_t count, std::uint64_t block_vertices = 0,
                                BakeStats* stats = nullptr);
 
-// Rank `index` of `count` processes that bake one bake with bounces together (mpirun):
-// each computes every pass for its shard range, writes the pass into the shared file
-// `shared_prefix`.pass0 or .pass1 (alternating; every rank must see the same file) and calls
-// `barrier`, which returns once every rank has called it; pass b + 1 then maps the whole
-// pass b. The last pass's sums go to the shard at `path`, as bake_shard_to_file writes it,
-// so the shards merge into the one-process bake's bytes. The caller removes the shared
-// files after the last barrier. docs/ARCHITECTURE.md, "Scale".
-TransferSet bake_rank_with_bounces(const meshes::Mesh& mesh, const BakeOptions& options,
-                                   const std::filesystem::path& path,
-                                   const std::filesystem::path& shared_prefix, std::uint32_t index,
-                                   std::uint32_t count, const std::function<void()>& barrier,
-                                   std::uint64_t block_vertices = 0, BakeStats* stats = nullptr);
+// Rank `index` of `count` processes that bake one file at `path` together (mpirun): each
+// writes the rows of its shard range (prt::shard_range) straight into the partial file that
+// prt::TransferSliceWriter keeps beside `path`; once every rank has returned, one calls
+// prt::commit_transfer_slices(path, shape), and the file is the one-process bake's bytes.
+// With bounces, each rank computes every pass for its range of the spatial order, writes the
+// pass into `path`.pass0 or .pass1 (alternating; every rank must see the same file) and calls
+// `barrier`, which returns once every rank has called it; pass b + 1 then reads pass b. The
+// caller removes the pass files after the last barrier. docs/ARCHITECTURE.md, "Scale".
+TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& options,
+                      const std::filesystem::path& path, std::uint32_t index, std::uint32_t count,
+                      const std::function<void()>& barrier, std::uint64_t block_vertices = 0,
+                      BakeStats* stats = nullptr);
 
 // Vertices per block holding about 16 MiB of transfer (a multiple of 64, at least 64).
 std::uint64_t default_block_vertices(std::size_t floats_per_vertex);

@@ -51,6 +51,39 @@ class TransferFileWriter {
   std::uint64_t expected_ = 0, written_ = 0, hash_ = 0;
 };
 
+// One of several processes that write one transfer file together (mpirun prtr bake): each
+// writes the payload rows of its vertex range [first, end) straight to their place in a
+// partial file beside `path` (partial_transfer_path), which all of them open, so nothing is
+// merged afterwards. Once every writer has closed, one process calls commit_transfer_slices.
+// The partial file is not the output: a job that dies leaves `path` untouched, and a rerun
+// rewrites every byte of the partial file it reads.
+class TransferSliceWriter {
+ public:
+  TransferSliceWriter(const std::filesystem::path& path, const TransferSet& shape,
+                      std::uint64_t first_vertex, std::uint64_t end_vertex);
+  ~TransferSliceWriter();
+  TransferSliceWriter(const TransferSliceWriter&) = delete;
+  TransferSliceWriter& operator=(const TransferSliceWriter&) = delete;
+
+  // The next `floats` values of the slice; throws on a non-finite value or an overrun.
+  void append(const float* data, std::size_t floats);
+  // Throws unless exactly the slice's floats were appended; flushes them to disk.
+  void close();
+
+ private:
+  TransferSet shape_;
+  std::filesystem::path partial_;
+  int fd_ = -1;
+  std::uint64_t first_float_ = 0, expected_ = 0, written_ = 0;
+};
+
+std::filesystem::path partial_transfer_path(const std::filesystem::path& path);
+
+// After every TransferSliceWriter of `path` closed: checksums the partial file's payload,
+// writes the header, cuts the file to its size (a rerun may find a longer one) and renames
+// it over `path`. Throws TransferFileError when the partial file is shorter than the payload.
+void commit_transfer_slices(const std::filesystem::path& path, const TransferSet& shape);
+
 // The 128-byte header alone, for containers that carry one (transfer shards,
 // prt/transfer_shard.h). encode throws std::invalid_argument for fields out of range;
 // decode checks it as read_transfer does and throws TransferFileError naming `name`.
