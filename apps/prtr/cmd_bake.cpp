@@ -163,8 +163,11 @@ Runner add_bake_command(CLI::App& app) {
   cmd->add_option("MESH", opt->mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("-o,--output", opt->output, "Transfer file to write (.prtx)")->required();
   add_bake_flags(cmd, opt->flags);
-  cmd->add_option("--block-vertices", opt->block,
-                  "Vertices computed and written per block (0: about 64 MiB of transfer)")
+  cmd->add_option(
+         "--block-vertices", opt->block,
+         "Vertices computed and written per block (0: about 16 MiB of transfer); a bounce's "
+         "cache of previous-pass rows holds " +
+             std::to_string(prt::kGatherBlocks) + " blocks")
       ->capture_default_str();
   cmd->add_option("--shard", opt->shard,
                   "k/n: bake only shard k (0-based) of n vertex ranges into a shard file for "

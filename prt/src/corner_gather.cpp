@@ -39,7 +39,8 @@ CornerGather::CornerGather(const meshes::Mesh& mesh, std::size_t floats_per_vert
       per_vertex_(floats_per_vertex),
       slot_of_(mesh.vertex_count(), kNone),
       stamp_(mesh.vertex_count(), 0) {
-  grow(std::max<std::size_t>(1, capacity_rows));
+  // Never more rows than the pass has.
+  grow(std::clamp<std::size_t>(capacity_rows, 1, std::max<std::size_t>(1, mesh.vertex_count())));
 }
 
 void CornerGather::grow(std::size_t capacity_rows) {

@@ -1,5 +1,5 @@
 // common/mapped_file.h: a read-only memory map of a whole file, for inputs larger than the
-// memory a process should hold (a streaming bake's previous pass, a .prtx being compressed).
+// memory a process should hold (a .prtx being compressed).
 // Pages come from the page cache on first touch; release() drops this process's mappings of
 // them so its resident set stays bounded by what it touched since, while the kernel keeps
 // the pages cached for a cheap re-fault. Scattered small reads should use read() instead: a
