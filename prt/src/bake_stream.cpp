@@ -225,6 +225,22 @@ void rank_shadow(detail::BakeEngine& engine, const Layout& layout, const ShardRa
   engine.finish_pass();
 }
 
+// The shadow pass of vertices [first, end) in index order, appended to `writer` a block at a
+// time: the whole bake when nothing reads another vertex's transfer (no bounces).
+template <class Writer>
+void shadow_in_index_order(detail::BakeEngine& engine, std::uint64_t first, std::uint64_t end,
+                           std::uint64_t block, Writer& writer) {
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  std::vector<float> buffer(std::min(end - first, block) * per_vertex);
+  engine.start_pass(0);
+  for (std::uint64_t begin = first; begin < end; begin += block) {
+    const std::uint64_t stop = std::min(end, begin + block);
+    engine.shadow(detail::index_range(begin, stop), buffer.data(), nullptr);
+    writer.append(buffer.data(), (stop - begin) * per_vertex);
+  }
+  engine.finish_pass();
+}
+
 }  // namespace
 
 TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::path& path,
@@ -247,15 +263,7 @@ TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::
                   block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex)));
   TransferSliceWriter writer(path, shape, range.first, range.end);
   if (o.bounces == 0) {
-    // Nothing reads another vertex's transfer: the index range, straight to its place.
-    std::vector<float> buffer(block * per_vertex);
-    engine.start_pass(0);
-    for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
-      const std::uint64_t end = std::min(range.end, begin + block);
-      engine.shadow(detail::index_range(begin, end), buffer.data(), nullptr);
-      writer.append(buffer.data(), (end - begin) * per_vertex);
-    }
-    engine.finish_pass();
+    shadow_in_index_order(engine, range.first, range.end, block, writer);
     writer.close();
     engine.finish();
     return shape;
@@ -328,17 +336,11 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
   const std::uint64_t block =
       std::min(v, block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex));
   TransferFileWriter writer(path, shape);
-  std::vector<float> buffer(block * per_vertex);
-  engine.start_pass(0);
   if (o.bounces == 0) {
-    // Nothing reads another vertex's transfer: index order, straight to the output.
-    for (std::uint64_t begin = 0; begin < v; begin += block) {
-      const std::uint64_t end = std::min(v, begin + block);
-      engine.shadow(detail::index_range(begin, end), buffer.data(), nullptr);
-      writer.append(buffer.data(), (end - begin) * per_vertex);
-    }
-    engine.finish_pass();
+    shadow_in_index_order(engine, 0, v, block, writer);
   } else {
+    std::vector<float> buffer(block * per_vertex);
+    engine.start_pass(0);
     const Layout layout(mesh);
     engine.set_row_order(layout.row_of.data());
     auto shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
@@ -387,14 +389,7 @@ TransferSet bake_shard_to_file(const meshes::Mesh& mesh, const BakeOptions& o, c
   const std::uint64_t block =
       block_vertices > 0 ? block_vertices : default_block_vertices(per_vertex);
   TransferShardWriter writer(path, shape, range);
-  std::vector<float> buffer(std::min(range.end - range.first, block) * per_vertex);
-  engine.start_pass(0);
-  for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
-    const std::uint64_t end = std::min(range.end, begin + block);
-    engine.shadow(detail::index_range(begin, end), buffer.data(), nullptr);
-    writer.append(buffer.data(), (end - begin) * per_vertex);
-  }
-  engine.finish_pass();
+  shadow_in_index_order(engine, range.first, range.end, block, writer);
   writer.commit();
   engine.finish();
   return shape;
