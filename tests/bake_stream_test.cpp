@@ -9,9 +9,11 @@
 
 #include <gtest/gtest.h>
 
+#include <barrier>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace {
@@ -188,6 +190,60 @@ TEST(Shards, MergeRefusesShardsThatDoNotBelongTogether) {
   std::ofstream(damaged, std::ios::binary) << bytes;
   e = merge_error({good[0], damaged, good[2]}, out);
   EXPECT_NE(e.find("damaged"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// prt::bake_rank as mpirun runs it, with the ranks as threads and a std::barrier: every rank
+// writes its rows into OUT.partial, one commits, and the file is the one-process bake's.
+void expect_ranks_equal_one_process(const prt::BakeOptions& o, std::uint32_t ranks,
+                                    std::uint64_t block, const std::string& name) {
+  const meshes::Mesh mesh = torus();
+  const fs::path one = test_support::scratch("bake_ranks_" + name, "one.prtx");
+  const fs::path out = test_support::scratch("bake_ranks_" + name, "ranks.prtx");
+  prt::bake_to_file(mesh, o, one, block);
+  // A stale partial file, longer than the output, as a crashed job would leave.
+  std::ofstream(prt::partial_transfer_path(out), std::ios::binary)
+      << std::string(fs::file_size(one) + 999, '\x7f');
+  std::barrier<> sync{std::ptrdiff_t(ranks)};
+  std::vector<prt::TransferSet> shapes(ranks);
+  std::vector<std::string> errors(ranks);
+  std::vector<std::thread> threads;
+  for (std::uint32_t r = 0; r < ranks; ++r) {
+    threads.emplace_back([&, r] {
+      try {
+        shapes[r] = prt::bake_rank(
+            mesh, o, out, r, ranks, [&] { sync.arrive_and_wait(); }, block);
+      } catch (const std::exception& e) {
+        errors[r] = e.what();
+      }
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  for (const std::string& e : errors) ASSERT_EQ(e, "") << name;
+  prt::commit_transfer_slices(out, shapes[0]);
+  EXPECT_FALSE(fs::exists(prt::partial_transfer_path(out))) << name;
+  EXPECT_TRUE(test_support::slurp(one) == test_support::slurp(out)) << name << ": differs";
+  for (const char* pass : {".pass0", ".pass1"}) fs::remove(out.string() + pass);
+}
+
+TEST(Ranks, RanksWritingOneFileEqualOneProcess) {
+  expect_ranks_equal_one_process(small_options(prt::TransferKind::kGlossy, 0), 3, 16, "b0");
+  expect_ranks_equal_one_process(small_options(prt::TransferKind::kDiffuse, 1), 2, 37, "b1");
+  expect_ranks_equal_one_process(small_options(prt::TransferKind::kDiffuse, 2), 3, 8, "b2");
+}
+
+TEST(Ranks, ACommitRefusesAPartialFileShorterThanThePayload) {
+  const fs::path out = test_support::scratch("bake_ranks_short", "short.prtx");
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 0);
+  const prt::TransferSet shape = prt::bake_rank(
+      torus(), o, out, 0, 2, [] {}, 16);  // rank 1 never ran
+  try {
+    prt::commit_transfer_slices(out, shape);
+    FAIL() << "a partial file with half a payload was committed";
+  } catch (const prt::TransferFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("shorter than the payload"), std::string::npos)
+        << e.what();
+  }
   EXPECT_FALSE(fs::exists(out));
 }
 
