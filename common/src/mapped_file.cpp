@@ -75,4 +75,20 @@ void read_exact(int fd, void* out, std::size_t bytes, std::uint64_t offset, cons
   }
 }
 
+void write_exact(int fd, const void* data, std::size_t bytes, std::uint64_t offset,
+                 const char* what) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  while (bytes > 0) {
+    const ssize_t n = ::pwrite(fd, p, bytes, static_cast<off_t>(offset));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      throw IoError(std::string(what) + ": write failed (" +
+                    (n == 0 ? std::string("disk full?") : std::strerror(errno)) + ")");
+    }
+    p += n;
+    bytes -= static_cast<std::size_t>(n);
+    offset += static_cast<std::uint64_t>(n);
+  }
+}
+
 }  // namespace common

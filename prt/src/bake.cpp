@@ -747,14 +747,12 @@ void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
 }
 
 void BakeEngine::bounce(VertexList vertices, const std::vector<HitBlock>& hits,
-                        const PassReader& read, std::size_t gather_bytes, float* dst) {
+                        const PassReader& read, std::size_t cache_rows, float* dst) {
   const auto start = Clock::now();
   State& st = *state_;
   if (st.frames.empty()) set_row_order(nullptr);
-  if (!st.gather) {
-    st.gather = std::make_unique<CornerGather>(st.ctx.mesh, st.ctx.per_vertex,
-                                               gather_bytes / (st.ctx.per_vertex * sizeof(float)));
-  }
+  if (!st.gather)
+    st.gather = std::make_unique<CornerGather>(st.ctx.mesh, st.ctx.per_vertex, cache_rows);
   CornerGather& gather = *st.gather;
   for (std::size_t first = 0; first < vertices.size();) {
     const std::size_t last = gather.collect(hits, first, vertices.size());

@@ -70,11 +70,12 @@ class BakeEngine {
   void bounce(VertexList vertices, const std::vector<HitBlock>& hits, const float* previous,
               float* dst);
   // The same bounce, reading the previous pass through `read` instead of holding it: the rows
-  // that a group of chunks' hits reach are gathered into memory, groups taken so that they
-  // hold about gather_bytes (at least one chunk's), so memory stays bounded whatever the
-  // mesh. Same bits as bounce().
+  // that a group of vertices' hits reach are read into a cache of cache_rows rows (grown only
+  // for a single vertex that needs more), so memory stays bounded whatever the mesh
+  // (corner_gather.h). The cache is made by the first call and kept across calls and passes.
+  // Same bits as bounce().
   void bounce(VertexList vertices, const std::vector<HitBlock>& hits, const PassReader& read,
-              std::size_t gather_bytes, float* dst);
+              std::size_t cache_rows, float* dst);
   // Fills the remaining stats (ray counts, flagged vertices, total time).
   void finish();
 

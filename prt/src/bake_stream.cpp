@@ -153,7 +153,7 @@ std::shared_ptr<Scratch> stream_bounces(detail::BakeEngine& engine, const Layout
       // Every block but the last has `block` vertices, so the same number of chunks.
       const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
       hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block * row_bytes,
+      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block,
                     current.data());
       previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
@@ -181,16 +181,8 @@ class SharedPass {
   SharedPass& operator=(const SharedPass&) = delete;
 
   void write(const float* data, std::size_t floats, std::uint64_t first_float) {
-    const auto* p = reinterpret_cast<const char*>(data);
-    std::size_t left = floats * sizeof(float);
-    off_t at = off_t(first_float * sizeof(float));
-    while (left > 0) {
-      const ssize_t n = ::pwrite(fd_, p, left, at);
-      if (n <= 0) throw common::IoError(path_.string() + ": cannot write (disk full?)");
-      p += n;
-      at += n;
-      left -= std::size_t(n);
-    }
+    common::write_exact(fd_, data, floats * sizeof(float), first_float * sizeof(float),
+                        path_.c_str());
   }
   void read(void* out, std::size_t bytes, std::uint64_t offset) const {
     common::read_exact(fd_, out, bytes, offset, path_.c_str());
@@ -296,7 +288,7 @@ TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::
       const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
       const std::uint64_t local = begin - range.first;
       hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block * row_bytes,
+      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block,
                     current.data());
       running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
       for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];

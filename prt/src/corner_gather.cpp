@@ -12,9 +12,18 @@
 
 namespace prt::detail {
 
+namespace {
+// n values rounded up to whole 2 MB huge pages.
+template <class T>
+std::size_t huge_page_bytes(std::size_t n) {
+  constexpr std::size_t huge = std::size_t(2) << 20;
+  return (n * sizeof(T) + huge - 1) / huge * huge;
+}
+}  // namespace
+
 template <class T>
 T* HugePageAllocator<T>::allocate(std::size_t n) {
-  const std::size_t bytes = (n * sizeof(T) + (2u << 20) - 1) / (2u << 20) * (2u << 20);
+  const std::size_t bytes = huge_page_bytes<T>(n);
   void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
   if (p == MAP_FAILED) throw std::bad_alloc();
   ::madvise(p, bytes, MADV_HUGEPAGE);
@@ -22,8 +31,7 @@ T* HugePageAllocator<T>::allocate(std::size_t n) {
 }
 template <class T>
 void HugePageAllocator<T>::deallocate(T* p, std::size_t n) {
-  const std::size_t bytes = (n * sizeof(T) + (2u << 20) - 1) / (2u << 20) * (2u << 20);
-  ::munmap(p, bytes);
+  ::munmap(p, huge_page_bytes<T>(n));
 }
 template struct HugePageAllocator<float>;
 

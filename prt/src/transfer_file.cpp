@@ -380,19 +380,28 @@ TransferFileWriter::TransferFileWriter(const fs::path& path, const TransferSet& 
 
 TransferFileWriter::~TransferFileWriter() = default;
 
+namespace {
+// Throws std::invalid_argument naming `file` and the value's place at the first non-finite
+// value of data, the payload's floats [first, first + floats).
+void check_finite(const fs::path& file, const TransferSet& shape, const float* data,
+                  std::size_t floats, std::uint64_t first) {
+  for (std::size_t i = 0; i < floats; ++i) {
+    if (!std::isfinite(data[i])) {
+      throw std::invalid_argument(file.string() +
+                                  ": cannot write the transfer set: non-finite value " +
+                                  num(data[i]) + " at " + locate(shape, first + i));
+    }
+  }
+}
+}  // namespace
+
 void TransferFileWriter::append(const float* data, std::size_t floats) {
   if (floats > expected_ - written_) {
     throw std::invalid_argument(file_->target().string() +
                                 ": cannot write the transfer set: more than " +
                                 std::to_string(expected_) + " floats appended");
   }
-  for (std::size_t i = 0; i < floats; ++i) {
-    if (!std::isfinite(data[i])) {
-      throw std::invalid_argument(file_->target().string() +
-                                  ": cannot write the transfer set: non-finite value " +
-                                  num(data[i]) + " at " + locate(shape_, written_ + i));
-    }
-  }
+  check_finite(file_->target(), shape_, data, floats, written_);
   hash_ = common::fnv1a(data, floats * sizeof(float), hash_);
   if (floats > 0) file_->write(data, floats * sizeof(float));
   written_ += floats;
@@ -452,27 +461,9 @@ void TransferSliceWriter::append(const float* data, std::size_t floats) {
     throw std::invalid_argument(partial_.string() + ": cannot write the transfer set: more than " +
                                 std::to_string(expected_) + " floats appended to the slice");
   }
-  for (std::size_t i = 0; i < floats; ++i) {
-    if (!std::isfinite(data[i])) {
-      throw std::invalid_argument(
-          partial_.string() + ": cannot write the transfer set: non-finite value " + num(data[i]) +
-          " at " + locate(shape_, first_float_ + written_ + i));
-    }
-  }
-  const auto* p = reinterpret_cast<const unsigned char*>(data);
-  std::size_t left = floats * sizeof(float);
-  off_t at = off_t(kHeaderBytes + (first_float_ + written_) * sizeof(float));
-  while (left > 0) {
-    const ssize_t n = ::pwrite(fd_, p, left, at);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      throw common::IoError(partial_.string() + ": write failed (" +
-                            std::string(n < 0 ? std::strerror(errno) : "disk full?") + ")");
-    }
-    p += n;
-    at += n;
-    left -= std::size_t(n);
-  }
+  check_finite(partial_, shape_, data, floats, first_float_ + written_);
+  common::write_exact(fd_, data, floats * sizeof(float),
+                      kHeaderBytes + (first_float_ + written_) * sizeof(float), partial_.c_str());
   written_ += floats;
 }
 

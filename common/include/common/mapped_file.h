@@ -41,5 +41,9 @@ class MappedFile {
 // Reads exactly `bytes` at `offset` of the open descriptor `fd`; throws IoError naming
 // `what` on a short read or an error.
 void read_exact(int fd, void* out, std::size_t bytes, std::uint64_t offset, const char* what);
+// Writes exactly `bytes` at `offset` of `fd` (pwrite, retried on short writes); throws
+// IoError naming `what` on an error or a full disk.
+void write_exact(int fd, const void* data, std::size_t bytes, std::uint64_t offset,
+                 const char* what);
 
 }  // namespace common
