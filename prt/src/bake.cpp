@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -552,22 +553,86 @@ void corner_view_directions(const BakeContext& ctx, BounceScratch& s, const Boun
   s.corner_y = s.corner_batch;  // column-major: each corner's values contiguous
 }
 
+// A multiply-add rounded as Eigen's packet code rounds it: fused where the target has FMA.
+inline float multiply_add(float a, float b, float c) {
+#if defined(__FMA__)
+  return std::fma(a, b, c);
+#else
+  return a * b + c;
+#endif
+}
+
+// out += sum_c beta[c] y_c^T M_c over a hit triangle's three corners (M_c: n x n, row-major;
+// y_c: n contiguous values, the three one after another), each element rounded exactly as
+// Eigen's matrix-vector product rounds `out.noalias() += beta[c] * (y_c^T * M_c)` for c = 0, 1,
+// 2 in turn: a fused chain over the rows of M_c from zero, then one multiply-add onto out.
+// Eigen's kernel runs one corner at a time, so each output element waits on its own chain of
+// n dependent multiply-adds; here the three corners' chains run side by side, with the
+// accumulators in registers when n is known at compile time (N > 0).
+template <int N>
+void interpolate_corners(const float* const corners[3], const float* y, const float beta[3],
+                         int n_runtime, float* out) {
+  const int n = N > 0 ? N : n_runtime;
+  constexpr int kMax = N > 0 ? N : kMaxOrder * kMaxOrder;
+  float g[3][kMax];
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < n; ++i) g[c][i] = 0.f;
+  for (int j = 0; j < n; ++j) {
+    for (int c = 0; c < 3; ++c) {
+      const float x = y[c * n + j];
+      const float* m = corners[c] + std::size_t(j) * n;
+      for (int i = 0; i < n; ++i) g[c][i] = multiply_add(m[i], x, g[c][i]);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    float r = out[i];
+    for (int c = 0; c < 3; ++c) r = multiply_add(g[c][i], beta[c], r);
+    out[i] = r;
+  }
+}
+
+using InterpolateCorners = void (*)(const float* const[3], const float*, const float[3], int,
+                                    float*);
+
+// The kernel for n coefficients, unrolled for the orders a glossy bake is usually run at.
+// Null where Eigen would round differently: it finishes a row count that is not a multiple
+// of 4 (odd orders) with scalar code, which this translation unit does not contract into
+// fused multiply-adds.
+InterpolateCorners corner_interpolation(int n) {
+  switch (n) {
+    case 16:
+      return interpolate_corners<16>;
+    case 36:
+      return interpolate_corners<36>;
+    case 64:
+      return interpolate_corners<64>;
+    default:
+      return n % 4 == 0 ? interpolate_corners<0> : nullptr;
+  }
+}
+
 // rows.row(h): the radiance hit h sends toward p in channel ch, as a function of lighting,
 // interpolated from its triangle's corners.
 void hit_radiance_rows(const BakeContext& ctx, BounceScratch& s, const BounceSource& src,
                        const HitRecord* hits, int count, int ch) {
   const int n = ctx.setup.n;
   s.rows.topRows(count).setZero();
+  const InterpolateCorners interpolate = corner_interpolation(n);
   for (int h = 0; h < count; ++h) {
     const meshes::Triangle& tri = ctx.mesh.triangles[hits[h].triangle];
     const float beta[3] = {1.f - hits[h].u - hits[h].v, hits[h].u, hits[h].v};
-    for (int c = 0; c < 3; ++c) {
-      const float* corner = src.row(tri[c]) + ch * src.per_channel;
-      if (ctx.glossy) {
-        s.rows.row(h).noalias() += beta[c] * (s.corner_y.col(3 * h + c).transpose() *
-                                              Eigen::Map<const RowMatF>(corner, n, n));
-      } else {
-        s.rows.row(h) += beta[c] * Eigen::Map<const Eigen::RowVectorXf>(corner, n);
+    const float* corners[3];
+    for (int c = 0; c < 3; ++c) corners[c] = src.row(tri[c]) + ch * src.per_channel;
+    if (ctx.glossy && interpolate) {
+      interpolate(corners, s.corner_y.col(3 * h).data(), beta, n, s.rows.row(h).data());
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        if (ctx.glossy) {
+          s.rows.row(h).noalias() += beta[c] * (s.corner_y.col(3 * h + c).transpose() *
+                                                Eigen::Map<const RowMatF>(corners[c], n, n));
+        } else {
+          s.rows.row(h) += beta[c] * Eigen::Map<const Eigen::RowVectorXf>(corners[c], n);
+        }
       }
     }
   }
