@@ -176,6 +176,53 @@ TEST(TransferFile, TwoWritesAreBitIdentical) {
   EXPECT_EQ(bytes_a, slurp(b));
 }
 
+// A bake with bounces finishes vertices in a spatial order and places their rows: in any
+// order and any run lengths, the file equals one written in vertex order, checksum included.
+TEST(TransferFile, PlacedRowsEqualAppendedRows) {
+  const TransferSet set = make_set(TransferKind::kGlossy, 3, 3, 101, prt::MaterialKind::kPhong, 4);
+  const fs::path appended = scratch("appended.prtx"), placed = scratch("placed.prtx");
+  prt::write_transfer(appended, set);
+  std::vector<std::uint64_t> starts;  // runs of 1-4 vertices, placed in a shuffled order
+  for (std::uint64_t v = 0; v < set.vertex_count; v += 1 + v % 4) starts.push_back(v);
+  std::shuffle(starts.begin(), starts.end(), std::mt19937(3));
+  const std::size_t per_vertex = set.floats_per_vertex();
+  prt::TransferFileWriter writer(placed, set);
+  for (const std::uint64_t v : starts) {
+    const std::uint64_t count = std::min<std::uint64_t>(1 + v % 4, set.vertex_count - v);
+    writer.place(v, set.data.data() + v * per_vertex, count);
+  }
+  writer.commit();
+  EXPECT_EQ(slurp(placed), slurp(appended));
+  expect_same(prt::read_transfer(placed), set);
+}
+
+TEST(TransferFile, PlacingRefusesStrayRowsAndAMissingRowLeavesNoFile) {
+  const TransferSet set =
+      make_set(TransferKind::kDiffuse, 2, 1, 10, prt::MaterialKind::kLambert, 5);
+  const std::size_t per_vertex = set.floats_per_vertex();
+  const fs::path p = scratch("placed_refused.prtx");
+  fs::remove(p);
+  {
+    prt::TransferFileWriter writer(p, set);
+    EXPECT_THROW(writer.place(9, set.data.data(), 2), std::invalid_argument);  // past the mesh
+    std::vector<float> bad(set.data.begin(), set.data.begin() + per_vertex);
+    bad[1] = std::numeric_limits<float>::quiet_NaN();
+    try {
+      writer.place(3, bad.data(), 1);
+      ADD_FAILURE() << "a NaN was placed";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("vertex 3"), std::string::npos) << e.what();
+    }
+    for (std::uint64_t v = 0; v < 9; ++v) writer.place(v, set.data.data() + v * per_vertex, 1);
+    EXPECT_THROW(writer.append(set.data.data(), per_vertex), std::logic_error);
+    EXPECT_THROW(writer.commit(), std::invalid_argument);  // vertex 9 is missing
+  }
+  EXPECT_FALSE(fs::exists(p));
+  prt::TransferFileWriter appending(p, set);
+  appending.append(set.data.data(), per_vertex);
+  EXPECT_THROW(appending.place(1, set.data.data() + per_vertex, 1), std::logic_error);
+}
+
 TEST(TransferFile, HeaderOnlyReadSkipsPayload) {
   // 1500 vertices x 36 x 36 floats: 7.8 MB, enough that reading it would be noticeable.
   const TransferSet set =

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <future>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -94,6 +95,30 @@ fs::path scratch_target(const fs::path& path, const std::string& what) {
   return path.parent_path() / (path.filename().string() + "." + what);
 }
 
+// One task at a time beside the computation: a block's file writes run while the next block
+// is computed, instead of holding up both cores' threads. run() waits for the previous task
+// (and rethrows its failure), so a task may use a buffer until the task after it is started;
+// callers alternate between two.
+class Overlap {
+ public:
+  Overlap() = default;
+  Overlap(const Overlap&) = delete;
+  Overlap& operator=(const Overlap&) = delete;
+  ~Overlap() {
+    if (pending_.valid()) pending_.wait();  // an exception is already on its way
+  }
+  void run(std::function<void()> task) {
+    wait();
+    pending_ = std::async(std::launch::async, std::move(task));
+  }
+  void wait() {
+    if (pending_.valid()) pending_.get();
+  }
+
+ private:
+  std::future<void> pending_;
+};
+
 // The vertices of a bake with bounces in spatial order (meshes::spatial_order), and where
 // each one's row is: every pass and running sum is stored in that order.
 struct Layout {
@@ -126,45 +151,56 @@ void append_in_index_order(const Rows& rows, const Layout& layout, std::uint64_t
 }
 
 // The bounce passes, over the vertices in layout order: bounce b reads M^{b-1} of every
-// vertex through a map of the previous pass's scratch file, and the running sum S^{b-1}
-// block by block, and writes S^b = S^{b-1} + M^b and M^b (for the next bounce). Returns the
-// file of the last S^b, in layout order.
-std::shared_ptr<Scratch> stream_bounces(detail::BakeEngine& engine, const Layout& layout,
-                                        int bounces, std::uint64_t block, const fs::path& path,
-                                        const HitStore& hits,
-                                        std::shared_ptr<Scratch> previous_pass) {
+// vertex through the row cache from the previous pass's scratch file, and the running sum
+// S^{b-1} block by block, and writes M^b (for the next bounce) and S^b = S^{b-1} + M^b: to a
+// scratch file, or, for the last bounce, row by row to its place in the output. The output
+// takes its rows out of order, rather than a last pass reading S^b back in index order to
+// append it: that pass wrote and read the whole payload once more.
+void stream_bounces(detail::BakeEngine& engine, const Layout& layout, int bounces,
+                    std::uint64_t block, const fs::path& path, const HitStore& hits,
+                    std::shared_ptr<Scratch> previous_pass, TransferFileWriter& writer) {
   const std::uint64_t v = engine.vertex_count();
   const std::size_t per_vertex = engine.floats_per_vertex();
   const std::size_t row_bytes = per_vertex * sizeof(float);
   std::shared_ptr<Scratch> previous_sum = previous_pass;  // S^0 = M^0
-  std::vector<float> current(block * per_vertex), sum(block * per_vertex);
+  std::vector<float> current[2], sum(block * per_vertex);
+  for (std::vector<float>& c : current) c.resize(block * per_vertex);
   std::vector<HitBlock> hit_blocks;
+  Overlap overlap;
   for (int b = 1; b <= bounces; ++b) {
     const bool last = b == bounces;
     auto pass = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "bounce"));
-    auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
+    auto running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
     const Scratch& previous_rows = *previous_pass;
     const detail::PassReader read = [&](std::uint64_t first, std::uint64_t rows, float* out) {
       previous_rows.read(out, rows * row_bytes, first * row_bytes);
     };
     engine.start_pass(b);
-    for (std::uint64_t begin = 0; begin < v; begin += block) {
+    for (std::uint64_t begin = 0, k = 0; begin < v; begin += block, ++k) {
       const std::uint64_t end = std::min(v, begin + block), n = (end - begin) * per_vertex;
       // Every block but the last has `block` vertices, so the same number of chunks.
       const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
       hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block,
-                    current.data());
-      previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
-      for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
-      if (pass) pass->write(current.data(), n * sizeof(float));
-      running->write(sum.data(), n * sizeof(float));
+      float* const m = current[k % 2].data();
+      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block, m);
+      // pass and running by value: an exception unwinds them before overlap waits.
+      overlap.run([&, pass, running, begin, end, n, m, last] {
+        previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
+        for (std::size_t i = 0; i < n; ++i) sum[i] += m[i];
+        if (last) {
+          for (std::uint64_t i = begin; i < end; ++i)
+            writer.place(layout.order[i], sum.data() + (i - begin) * per_vertex, 1);
+        } else {
+          pass->write(m, n * sizeof(float));
+          running->write(sum.data(), n * sizeof(float));
+        }
+      });
     }
+    overlap.wait();
     engine.finish_pass();
     previous_pass = pass;
     previous_sum = running;
   }
-  return previous_sum;
 }
 
 // A pass of every vertex in one file beside the output, which each rank of a distributed
@@ -331,28 +367,33 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
   if (o.bounces == 0) {
     shadow_in_index_order(engine, 0, v, block, writer);
   } else {
-    std::vector<float> buffer(block * per_vertex);
     engine.start_pass(0);
     const Layout layout(mesh);
     engine.set_row_order(layout.row_of.data());
     auto shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
     HitStore hits(scratch_target(path, "hits"));
-    std::vector<HitBlock> hit_blocks;
-    for (std::uint64_t begin = 0; begin < v; begin += block) {
-      const std::uint64_t end = std::min(v, begin + block);
-      engine.shadow(layout.block(begin, end), buffer.data(), &hit_blocks);
-      shadow_pass->write(buffer.data(), (end - begin) * per_vertex * sizeof(float));
-      hits.store(hit_blocks);
+    {
+      std::vector<float> buffers[2];
+      std::vector<HitBlock> hit_blocks[2];
+      Overlap overlap;
+      for (std::uint64_t begin = 0, k = 0; begin < v; begin += block, ++k) {
+        const std::uint64_t end = std::min(v, begin + block);
+        std::vector<float>& buffer = buffers[k % 2];
+        std::vector<HitBlock>& blocks = hit_blocks[k % 2];
+        buffer.resize(block * per_vertex);
+        engine.shadow(layout.block(begin, end), buffer.data(), &blocks);
+        overlap.run([&, begin, end] {
+          shadow_pass->write(buffer.data(), (end - begin) * per_vertex * sizeof(float));
+          hits.store(blocks);
+        });
+      }
+      overlap.wait();
     }
     engine.finish_pass();
     engine.end_tracing();
-    buffer = {};
-    // Handed over, so that the shadow pass's scratch is removed as soon as the bounces are
-    // done with it, not kept beside the output while it is written.
-    const std::shared_ptr<Scratch> sums =
-        stream_bounces(engine, layout, o.bounces, block, path, hits, std::move(shadow_pass));
-    append_in_index_order(*sums, layout, 0, v, per_vertex, block,
-                          [&](const float* rows, std::size_t n) { writer.append(rows, n); });
+    // Handed over, so that each pass's scratch is removed as soon as the bounces are done
+    // with it.
+    stream_bounces(engine, layout, o.bounces, block, path, hits, std::move(shadow_pass), writer);
   }
   writer.commit();
   engine.finish();

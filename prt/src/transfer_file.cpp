@@ -378,9 +378,24 @@ TransferFileWriter::TransferFileWriter(const fs::path& path, const TransferSet& 
   file_->write(zeros.data(), zeros.size());
 }
 
-TransferFileWriter::~TransferFileWriter() = default;
+TransferFileWriter::~TransferFileWriter() {
+  if (place_fd_ >= 0) ::close(place_fd_);
+}
 
 namespace {
+// The FNV-1a checksum of the `floats` payload floats after the header of the file open at fd.
+std::uint64_t payload_checksum(int fd, std::uint64_t floats, const fs::path& name) {
+  const std::uint64_t bytes = kHeaderBytes + floats * sizeof(float);
+  std::uint64_t hash = common::kFnvOffset;
+  std::vector<unsigned char> buffer(std::size_t(16) << 20);
+  for (std::uint64_t at = kHeaderBytes; at < bytes; at += buffer.size()) {
+    const std::size_t n = std::size_t(std::min<std::uint64_t>(buffer.size(), bytes - at));
+    common::read_exact(fd, buffer.data(), n, at, name.c_str());
+    hash = common::fnv1a(buffer.data(), n, hash);
+  }
+  return hash;
+}
+
 // Throws std::invalid_argument naming `file` and the value's place at the first non-finite
 // value of data, the payload's floats [first, first + floats).
 void check_finite(const fs::path& file, const TransferSet& shape, const float* data,
@@ -396,6 +411,8 @@ void check_finite(const fs::path& file, const TransferSet& shape, const float* d
 }  // namespace
 
 void TransferFileWriter::append(const float* data, std::size_t floats) {
+  if (place_fd_ >= 0)
+    throw std::logic_error("TransferFileWriter: append() after place() on the same file");
   if (floats > expected_ - written_) {
     throw std::invalid_argument(file_->target().string() +
                                 ": cannot write the transfer set: more than " +
@@ -407,12 +424,40 @@ void TransferFileWriter::append(const float* data, std::size_t floats) {
   written_ += floats;
 }
 
+void TransferFileWriter::place(std::uint64_t first_vertex, const float* data, std::uint64_t count) {
+  const fs::path& target = file_->target();
+  if (written_ > 0 && place_fd_ < 0)
+    throw std::logic_error("TransferFileWriter: place() after append() on the same file");
+  if (first_vertex > shape_.vertex_count || count > shape_.vertex_count - first_vertex) {
+    throw std::invalid_argument(target.string() + ": cannot write the transfer set: vertices [" +
+                                std::to_string(first_vertex) + ", " +
+                                std::to_string(first_vertex + count) + ") are outside the mesh");
+  }
+  const std::uint64_t floats = count * shape_.floats_per_vertex();
+  if (floats > expected_ - written_) {
+    throw std::invalid_argument(target.string() + ": cannot write the transfer set: more than " +
+                                std::to_string(expected_) + " floats placed");
+  }
+  const std::uint64_t first = first_vertex * shape_.floats_per_vertex();
+  check_finite(target, shape_, data, floats, first);
+  if (place_fd_ < 0) {
+    place_fd_ = ::open(file_->temporary().c_str(), O_RDWR | O_CLOEXEC);
+    if (place_fd_ < 0)
+      throw common::IoError(target.string() + ": cannot reopen the temporary file (" +
+                            std::strerror(errno) + ")");
+  }
+  common::write_exact(place_fd_, data, floats * sizeof(float), kHeaderBytes + first * sizeof(float),
+                      file_->temporary().c_str());
+  written_ += floats;
+}
+
 void TransferFileWriter::commit() {
   if (written_ != expected_) {
     throw std::invalid_argument(file_->target().string() +
                                 ": cannot write the transfer set: " + std::to_string(written_) +
-                                " of " + std::to_string(expected_) + " floats were appended");
+                                " of " + std::to_string(expected_) + " floats were written");
   }
+  if (place_fd_ >= 0) hash_ = payload_checksum(place_fd_, expected_, file_->temporary());
   const Header h = encode_header(shape_, expected_, hash_);
   const int fd = ::open(file_->temporary().c_str(), O_WRONLY | O_CLOEXEC);
   if (fd < 0 || ::pwrite(fd, h.data(), h.size(), 0) != static_cast<ssize_t>(h.size())) {
@@ -497,14 +542,8 @@ void commit_transfer_slices(const fs::path& path, const TransferSet& shape) {
                               ": shorter than the payload; did every process "
                               "write its slice to the same directory?");
     }
-    std::uint64_t hash = common::kFnvOffset;
-    std::vector<unsigned char> buffer(std::size_t(16) << 20);
-    for (std::uint64_t at = kHeaderBytes; at < bytes; at += buffer.size()) {
-      const std::size_t n = std::size_t(std::min<std::uint64_t>(buffer.size(), bytes - at));
-      common::read_exact(fd, buffer.data(), n, at, partial.c_str());
-      hash = common::fnv1a(buffer.data(), n, hash);
-    }
-    const Header h = encode_header(without_payload(shape), floats, hash);
+    const Header h =
+        encode_header(without_payload(shape), floats, payload_checksum(fd, floats, partial));
     if (::pwrite(fd, h.data(), h.size(), 0) != static_cast<ssize_t>(h.size()) ||
         ::ftruncate(fd, off_t(bytes)) != 0 || ::fsync(fd) != 0) {
       throw common::IoError(partial.string() + ": cannot write the header (" +

@@ -41,7 +41,13 @@ class TransferFileWriter {
 
   // The next `floats` values of the payload; throws on a non-finite value or an overrun.
   void append(const float* data, std::size_t floats);
-  // Throws unless exactly the payload's floats were appended.
+  // The payload rows of `count` consecutive vertices from `first_vertex`, written where they
+  // belong, for a producer that finishes vertices out of order (a bake with bounces works in
+  // a spatial order). Every vertex must be placed once; the checksum is then computed at
+  // commit() from the file. Throws on a non-finite value, a range outside the mesh, or a
+  // writer that was appended to.
+  void place(std::uint64_t first_vertex, const float* data, std::uint64_t count);
+  // Throws unless exactly the payload's floats were appended or placed.
   void commit();
   std::uint64_t expected_floats() const { return expected_; }
 
@@ -49,6 +55,7 @@ class TransferFileWriter {
   TransferSet shape_;
   std::unique_ptr<common::AtomicFile> file_;
   std::uint64_t expected_ = 0, written_ = 0, hash_ = 0;
+  int place_fd_ = -1;  // the temporary file, for place()'s positioned writes
 };
 
 // One of several processes that write one transfer file together (mpirun prtr bake): each
