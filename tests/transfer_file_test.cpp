@@ -19,6 +19,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 #include <sstream>
@@ -221,6 +222,36 @@ TEST(TransferFile, PlacingRefusesStrayRowsAndAMissingRowLeavesNoFile) {
   prt::TransferFileWriter appending(p, set);
   appending.append(set.data.data(), per_vertex);
   EXPECT_THROW(appending.place(1, set.data.data() + per_vertex, 1), std::logic_error);
+}
+
+// Ranks of a bake with bounces each own a range of a spatial order, not of the index order:
+// each places its rows wherever they belong in the shared partial file.
+TEST(TransferFile, SlicesPlacedFromAnotherOrderCommitToTheFile) {
+  const TransferSet set = make_set(TransferKind::kGlossy, 2, 1, 57, prt::MaterialKind::kPhong, 6);
+  const fs::path expected = scratch("slices_expected.prtx"), out = scratch("slices_placed.prtx");
+  prt::write_transfer(expected, set);
+  fs::remove(out);
+  std::vector<std::uint64_t> order(set.vertex_count);
+  std::iota(order.begin(), order.end(), 0);
+  std::shuffle(order.begin(), order.end(), std::mt19937(8));
+  const std::size_t per_vertex = set.floats_per_vertex();
+  const std::uint64_t split = 20;  // rank 0 owns order[0, 20), rank 1 order[20, 57)
+  prt::TransferSliceWriter rank0(out, set, 0, split), rank1(out, set, split, set.vertex_count);
+  for (std::uint64_t i = set.vertex_count; i-- > 0;) {
+    prt::TransferSliceWriter& w = i < split ? rank0 : rank1;
+    w.place(order[i], set.data.data() + order[i] * per_vertex, 1);
+  }
+  EXPECT_THROW(rank0.place(order[0], set.data.data(), 1), std::invalid_argument);  // overrun
+  EXPECT_THROW(rank0.append(set.data.data(), 0), std::logic_error);
+  rank0.close();
+  rank1.close();
+  prt::commit_transfer_slices(out, set);
+  EXPECT_EQ(slurp(out), slurp(expected));
+
+  prt::TransferSliceWriter stray(scratch("slices_stray.prtx"), set, 0, 2);
+  EXPECT_THROW(stray.place(56, set.data.data(), 2), std::invalid_argument);  // past the mesh
+  stray.append(set.data.data(), per_vertex);
+  EXPECT_THROW(stray.place(1, set.data.data() + per_vertex, 1), std::logic_error);
 }
 
 TEST(TransferFile, HeaderOnlyReadSkipsPayload) {

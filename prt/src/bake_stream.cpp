@@ -130,26 +130,6 @@ struct Layout {
   std::vector<std::uint32_t> order, row_of;
 };
 
-// The rows of `rows` (a pass of every vertex in layout order) of vertices [first, last),
-// appended to `append` in index order, `block` vertices at a time. Read row by row rather
-// than mapped: the reads jump through the file, and a fault maps a whole page-cache folio
-// (up to megabytes), far more resident memory than the 5 KB row.
-template <class Rows>
-void append_in_index_order(const Rows& rows, const Layout& layout, std::uint64_t first,
-                           std::uint64_t last, std::size_t per_vertex, std::uint64_t block,
-                           const std::function<void(const float*, std::size_t)>& append) {
-  std::vector<float> buffer(std::min(block, last - first) * per_vertex);
-  const std::size_t row_bytes = per_vertex * sizeof(float);
-  for (std::uint64_t begin = first; begin < last; begin += block) {
-    const std::uint64_t end = std::min(last, begin + block);
-    for (std::uint64_t q = begin; q < end; ++q) {
-      rows.read(buffer.data() + (q - begin) * per_vertex, row_bytes,
-                std::uint64_t(layout.row_of[q]) * row_bytes);
-    }
-    append(buffer.data(), (end - begin) * per_vertex);
-  }
-}
-
 // The bounce passes, over the vertices in layout order: bounce b reads M^{b-1} of every
 // vertex through the row cache from the previous pass's scratch file, and the running sum
 // S^{b-1} block by block, and writes M^b (for the next bounce) and S^b = S^{b-1} + M^b: to a
@@ -235,21 +215,27 @@ class SharedPass {
   int fd_ = -1;
 };
 
-// The shadow pass of one rank's range of the layout: M^0 to the shared pass, S^0 = M^0 and
-// the hits to the rank's own scratch files.
-void rank_shadow(detail::BakeEngine& engine, const Layout& layout, const ShardRange& range,
-                 std::uint64_t block, SharedPass& pass, Scratch& sum, HitStore& hits) {
+// The shadow pass of the layout's vertices [first, end), a block at a time: each block's rows
+// and hits go to `store(rows, begin, end, hits)` on a task beside the next block's
+// computation.
+void shadow_in_layout_order(detail::BakeEngine& engine, const Layout& layout, std::uint64_t first,
+                            std::uint64_t end, std::uint64_t block,
+                            const std::function<void(const float*, std::uint64_t, std::uint64_t,
+                                                     const std::vector<HitBlock>&)>& store) {
   const std::size_t per_vertex = engine.floats_per_vertex();
-  std::vector<float> buffer(std::min(range.end - range.first, block) * per_vertex);
-  std::vector<HitBlock> hit_blocks;
+  std::vector<float> buffers[2];
+  std::vector<HitBlock> hit_blocks[2];
+  Overlap overlap;
   engine.start_pass(0);
-  for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
-    const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
-    engine.shadow(layout.block(begin, end), buffer.data(), &hit_blocks);
-    pass.write(buffer.data(), n, begin * per_vertex);
-    sum.write(buffer.data(), n * sizeof(float));
-    hits.store(hit_blocks);
+  for (std::uint64_t begin = first, k = 0; begin < end; begin += block, ++k) {
+    const std::uint64_t stop = std::min(end, begin + block);
+    std::vector<float>& rows = buffers[k % 2];
+    std::vector<HitBlock>& hits = hit_blocks[k % 2];
+    rows.resize(std::min(block, end - first) * per_vertex);
+    engine.shadow(layout.block(begin, stop), rows.data(), &hits);
+    overlap.run([&store, &rows, &hits, begin, stop] { store(rows.data(), begin, stop, hits); });
   }
+  overlap.wait();
   engine.finish_pass();
 }
 
@@ -303,12 +289,21 @@ TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::
                           SharedPass(path.string() + ".pass1")};
   HitStore hits(scratch_target(path, "hits"));
   auto running = std::make_shared<Scratch>(scratch_target(path, "sum"));
-  rank_shadow(engine, layout, range, block, passes[0], *running, hits);
+  shadow_in_layout_order(engine, layout, range.first, range.end, block,
+                         [&](const float* rows, std::uint64_t begin, std::uint64_t end,
+                             const std::vector<HitBlock>& blocks) {
+                           const std::uint64_t n = (end - begin) * per_vertex;
+                           passes[0].write(rows, n, begin * per_vertex);
+                           running->write(rows, n * sizeof(float));
+                           hits.store(blocks);
+                         });
   engine.end_tracing();
   barrier();  // every rank's M^0 is in passes[0]
-  std::vector<float> current(block * per_vertex), sum(block * per_vertex);
+  std::vector<float> current[2], sum(block * per_vertex);
+  for (std::vector<float>& c : current) c.resize(block * per_vertex);
   std::vector<HitBlock> hit_blocks;
   const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
+  Overlap overlap;
   for (int b = 1; b <= o.bounces; ++b) {
     const bool last = b == o.bounces;
     auto next_running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
@@ -320,27 +315,34 @@ TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::
       previous.read(out, rows * row_bytes, first * row_bytes);
     };
     engine.start_pass(b);
-    for (std::uint64_t begin = range.first; begin < range.end; begin += block) {
+    for (std::uint64_t begin = range.first, k = 0; begin < range.end; begin += block, ++k) {
       const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
       const std::uint64_t local = begin - range.first;
       hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block,
-                    current.data());
-      running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
-      for (std::size_t i = 0; i < n; ++i) sum[i] += current[i];
-      // The last pass's sums take the place of M^b: the shard is in index order, and its
-      // rows come from every rank's range of the layout.
-      passes[b % 2].write(last ? sum.data() : current.data(), n, begin * per_vertex);
-      if (!last) next_running->write(sum.data(), n * sizeof(float));
+      float* const m = current[k % 2].data();
+      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block, m);
+      // The shared pointers and b by value: an exception unwinds them before overlap waits.
+      overlap.run([&, running, next_running, b, begin, end, local, n, m, last] {
+        running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
+        for (std::size_t i = 0; i < n; ++i) sum[i] += m[i];
+        if (last) {
+          // The sums go straight to their place in the output, from this rank's range of
+          // the layout: the ranks' ranges together are every vertex once.
+          for (std::uint64_t i = begin; i < end; ++i)
+            writer.place(layout.order[i], sum.data() + (i - begin) * per_vertex, 1);
+        } else {
+          passes[b % 2].write(m, n, begin * per_vertex);
+          next_running->write(sum.data(), n * sizeof(float));
+        }
+      });
     }
+    overlap.wait();
     engine.finish_pass();
     running = next_running;
-    // Every rank's M^b (or S^b) is written, and nobody reads M^(b-1) any more, whose file
-    // pass b + 1 overwrites.
-    barrier();
+    // Every rank's M^b is written, and nobody reads M^(b-1) any more, whose file pass b + 1
+    // overwrites.
+    if (!last) barrier();
   }
-  append_in_index_order(passes[o.bounces % 2], layout, range.first, range.end, per_vertex, block,
-                        [&](const float* rows, std::size_t n) { writer.append(rows, n); });
   writer.close();
   engine.finish();
   return shape;
@@ -367,29 +369,16 @@ TransferSet bake_to_file(const meshes::Mesh& mesh, const BakeOptions& o, const f
   if (o.bounces == 0) {
     shadow_in_index_order(engine, 0, v, block, writer);
   } else {
-    engine.start_pass(0);
     const Layout layout(mesh);
     engine.set_row_order(layout.row_of.data());
     auto shadow_pass = std::make_shared<Scratch>(scratch_target(path, "shadow"));
     HitStore hits(scratch_target(path, "hits"));
-    {
-      std::vector<float> buffers[2];
-      std::vector<HitBlock> hit_blocks[2];
-      Overlap overlap;
-      for (std::uint64_t begin = 0, k = 0; begin < v; begin += block, ++k) {
-        const std::uint64_t end = std::min(v, begin + block);
-        std::vector<float>& buffer = buffers[k % 2];
-        std::vector<HitBlock>& blocks = hit_blocks[k % 2];
-        buffer.resize(block * per_vertex);
-        engine.shadow(layout.block(begin, end), buffer.data(), &blocks);
-        overlap.run([&, begin, end] {
-          shadow_pass->write(buffer.data(), (end - begin) * per_vertex * sizeof(float));
-          hits.store(blocks);
-        });
-      }
-      overlap.wait();
-    }
-    engine.finish_pass();
+    shadow_in_layout_order(engine, layout, 0, v, block,
+                           [&](const float* rows, std::uint64_t begin, std::uint64_t end,
+                               const std::vector<HitBlock>& blocks) {
+                             shadow_pass->write(rows, (end - begin) * per_vertex * sizeof(float));
+                             hits.store(blocks);
+                           });
     engine.end_tracing();
     // Handed over, so that each pass's scratch is removed as soon as the bounces are done
     // with it.

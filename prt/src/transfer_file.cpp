@@ -408,6 +408,27 @@ void check_finite(const fs::path& file, const TransferSet& shape, const float* d
     }
   }
 }
+
+// The floats of rows [first_vertex, first_vertex + count) of `shape`, after checking that they
+// are in the mesh, fit the `remaining` floats of the writer and are finite (messages name
+// `file`).
+std::uint64_t checked_rows(const fs::path& file, const TransferSet& shape,
+                           std::uint64_t first_vertex, const float* data, std::uint64_t count,
+                           std::uint64_t remaining) {
+  if (first_vertex > shape.vertex_count || count > shape.vertex_count - first_vertex) {
+    throw std::invalid_argument(file.string() + ": cannot write the transfer set: vertices [" +
+                                std::to_string(first_vertex) + ", " +
+                                std::to_string(first_vertex + count) + ") are outside the mesh");
+  }
+  const std::uint64_t floats = count * shape.floats_per_vertex();
+  if (floats > remaining) {
+    throw std::invalid_argument(
+        file.string() + ": cannot write the transfer set: " + std::to_string(floats) +
+        " floats placed with " + std::to_string(remaining) + " left to write");
+  }
+  check_finite(file, shape, data, floats, first_vertex * shape.floats_per_vertex());
+  return floats;
+}
 }  // namespace
 
 void TransferFileWriter::append(const float* data, std::size_t floats) {
@@ -425,29 +446,20 @@ void TransferFileWriter::append(const float* data, std::size_t floats) {
 }
 
 void TransferFileWriter::place(std::uint64_t first_vertex, const float* data, std::uint64_t count) {
-  const fs::path& target = file_->target();
   if (written_ > 0 && place_fd_ < 0)
     throw std::logic_error("TransferFileWriter: place() after append() on the same file");
-  if (first_vertex > shape_.vertex_count || count > shape_.vertex_count - first_vertex) {
-    throw std::invalid_argument(target.string() + ": cannot write the transfer set: vertices [" +
-                                std::to_string(first_vertex) + ", " +
-                                std::to_string(first_vertex + count) + ") are outside the mesh");
-  }
-  const std::uint64_t floats = count * shape_.floats_per_vertex();
-  if (floats > expected_ - written_) {
-    throw std::invalid_argument(target.string() + ": cannot write the transfer set: more than " +
-                                std::to_string(expected_) + " floats placed");
-  }
-  const std::uint64_t first = first_vertex * shape_.floats_per_vertex();
-  check_finite(target, shape_, data, floats, first);
+  const fs::path& temporary = file_->temporary();
+  const std::uint64_t floats =
+      checked_rows(file_->target(), shape_, first_vertex, data, count, expected_ - written_);
   if (place_fd_ < 0) {
-    place_fd_ = ::open(file_->temporary().c_str(), O_RDWR | O_CLOEXEC);
+    place_fd_ = ::open(temporary.c_str(), O_RDWR | O_CLOEXEC);
     if (place_fd_ < 0)
-      throw common::IoError(target.string() + ": cannot reopen the temporary file (" +
+      throw common::IoError(file_->target().string() + ": cannot reopen the temporary file (" +
                             std::strerror(errno) + ")");
   }
-  common::write_exact(place_fd_, data, floats * sizeof(float), kHeaderBytes + first * sizeof(float),
-                      file_->temporary().c_str());
+  common::write_exact(place_fd_, data, floats * sizeof(float),
+                      kHeaderBytes + first_vertex * shape_.floats_per_vertex() * sizeof(float),
+                      temporary.c_str());
   written_ += floats;
 }
 
@@ -502,6 +514,7 @@ TransferSliceWriter::~TransferSliceWriter() {
 }
 
 void TransferSliceWriter::append(const float* data, std::size_t floats) {
+  if (placed_) throw std::logic_error("TransferSliceWriter: append() after place()");
   if (floats > expected_ - written_) {
     throw std::invalid_argument(partial_.string() + ": cannot write the transfer set: more than " +
                                 std::to_string(expected_) + " floats appended to the slice");
@@ -509,6 +522,19 @@ void TransferSliceWriter::append(const float* data, std::size_t floats) {
   check_finite(partial_, shape_, data, floats, first_float_ + written_);
   common::write_exact(fd_, data, floats * sizeof(float),
                       kHeaderBytes + (first_float_ + written_) * sizeof(float), partial_.c_str());
+  written_ += floats;
+}
+
+void TransferSliceWriter::place(std::uint64_t first_vertex, const float* data,
+                                std::uint64_t count) {
+  if (written_ > 0 && !placed_)
+    throw std::logic_error("TransferSliceWriter: place() after append()");
+  const std::uint64_t floats =
+      checked_rows(partial_, shape_, first_vertex, data, count, expected_ - written_);
+  placed_ = true;
+  common::write_exact(fd_, data, floats * sizeof(float),
+                      kHeaderBytes + first_vertex * shape_.floats_per_vertex() * sizeof(float),
+                      partial_.c_str());
   written_ += floats;
 }
 

@@ -74,7 +74,13 @@ class TransferSliceWriter {
 
   // The next `floats` values of the slice; throws on a non-finite value or an overrun.
   void append(const float* data, std::size_t floats);
-  // Throws unless exactly the slice's floats were appended; flushes them to disk.
+  // Rows of `count` vertices from `first_vertex`, anywhere in the mesh, written where they
+  // belong: for a writer whose vertices are a range of another order (a bake with bounces
+  // gives each rank a range of the spatial order). They count toward the slice's size, and
+  // the writers together must write every row once. Throws on a non-finite value, rows
+  // outside the mesh or an overrun.
+  void place(std::uint64_t first_vertex, const float* data, std::uint64_t count);
+  // Throws unless exactly the slice's floats were appended or placed; flushes them to disk.
   void close();
 
  private:
@@ -82,6 +88,7 @@ class TransferSliceWriter {
   std::filesystem::path partial_;
   int fd_ = -1;
   std::uint64_t first_float_ = 0, expected_ = 0, written_ = 0;
+  bool placed_ = false;  // rows went through place(), so append() has no cursor
 };
 
 std::filesystem::path partial_transfer_path(const std::filesystem::path& path);
