@@ -1,6 +1,8 @@
 // The streaming bake (prt::bake_to_file) against the whole-mesh bake written by
 // write_transfer: the same bytes, whatever the block size, with and without bounces.
 #include "prt/bake.h"
+
+#include "common/atomic_file.h"
 #include "prt/transfer_file.h"
 #include "prt/transfer_shard.h"
 
@@ -113,6 +115,31 @@ TEST(StreamingBake, TheFileReadsBackAndAFailedBakeLeavesNothing) {
   o.order = 0;  // invalid: refused before anything is written
   EXPECT_THROW(prt::bake_to_file(torus(), o, dir / "bad.prtx", 16), std::invalid_argument);
   EXPECT_EQ(files_in(dir), 0u);
+}
+
+// A write that fails in the middle of a bake with bounces (here on the task that writes a
+// block while the next one is computed) fails the bake with the file's name, and leaves
+// neither the output nor any scratch file behind.
+TEST(StreamingBake, AWriteFailingMidBakeFailsItAndLeavesNothing) {
+  const fs::path dir = test_support::scratch("bake_stream_efbig", "dir");
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const prt::BakeOptions o = small_options(prt::TransferKind::kGlossy, 2);
+  // Each pass is 288 x 243 floats (280 KB); 64 KB fails after a few blocks of 16 vertices.
+  {
+    test_support::FileSizeLimit limit(64 * 1024);
+    if (!limit.ok()) GTEST_SKIP() << "cannot lower RLIMIT_FSIZE here";
+    try {
+      prt::bake_to_file(torus(), o, dir / "out.prtx", 16);
+      ADD_FAILURE() << "the bake did not fail";
+    } catch (const common::IoError& e) {
+      EXPECT_NE(std::string(e.what()).find("out.prtx"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_EQ(files_in(dir), 0u);
+  // Nothing is left that a rerun would trip over.
+  prt::bake_to_file(torus(), o, dir / "out.prtx", 16);
+  EXPECT_EQ(files_in(dir), 1u);
 }
 
 // Bakes shards k/n of `o` (block 16) into the scratch directory; returns their paths.

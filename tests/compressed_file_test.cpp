@@ -464,31 +464,6 @@ TEST(CompressedFile, MissingDirectoryThrowsAndLeavesNothing) {
   EXPECT_FALSE(fs::exists(dir));
 }
 
-// RLIMIT_FSIZE makes write(2) fail with EFBIG part-way through the payload, as on a full
-// disk. Restored on scope exit.
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    getrlimit(RLIMIT_FSIZE, &old_);
-    old_handler_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limit = old_;
-    limit.rlim_cur = std::min(bytes, old_.rlim_max);
-    ok_ = setrlimit(RLIMIT_FSIZE, &limit) == 0;
-  }
-  ~FileSizeLimit() {
-    setrlimit(RLIMIT_FSIZE, &old_);
-    std::signal(SIGXFSZ, old_handler_);
-  }
-  FileSizeLimit(const FileSizeLimit&) = delete;
-  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
-  bool ok() const { return ok_; }
-
- private:
-  rlimit old_{};
-  void (*old_handler_)(int) = SIG_DFL;
-  bool ok_ = false;
-};
-
 TEST(CompressedFile, FailedWriteLeavesNoFileAndNoTemporary) {
   const fs::path dir = scratch("failed_write");
   fs::remove_all(dir);
@@ -496,7 +471,7 @@ TEST(CompressedFile, FailedWriteLeavesNoFileAndNoTemporary) {
   const fs::path p = dir / "bunny.prtc";
   const CompressedSet big = make_set(4, 1, true, 500, 20, 8, 8);  // ~200 KB
   {
-    FileSizeLimit limit(64 * 1024);
+    test_support::FileSizeLimit limit(64 * 1024);
     if (!limit.ok()) GTEST_SKIP() << "cannot lower RLIMIT_FSIZE here";
     try {
       cpca::write_compressed(p, big);

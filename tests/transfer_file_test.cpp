@@ -569,31 +569,6 @@ TEST(TransferFile, WriterRefusesInconsistentSetsAndKeepsOldFile) {
   EXPECT_EQ(slurp(p), before);
 }
 
-// RLIMIT_FSIZE makes write(2) fail with EFBIG part-way through the payload: a real failed
-// write, as on a full disk. Restored on scope exit.
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    getrlimit(RLIMIT_FSIZE, &old_);
-    old_handler_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limit = old_;
-    limit.rlim_cur = std::min(bytes, old_.rlim_max);
-    ok_ = setrlimit(RLIMIT_FSIZE, &limit) == 0;
-  }
-  ~FileSizeLimit() {
-    setrlimit(RLIMIT_FSIZE, &old_);
-    std::signal(SIGXFSZ, old_handler_);
-  }
-  FileSizeLimit(const FileSizeLimit&) = delete;
-  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
-  bool ok() const { return ok_; }
-
- private:
-  rlimit old_{};
-  void (*old_handler_)(int) = SIG_DFL;
-  bool ok_ = false;
-};
-
 TEST(TransferFile, FailedWriteKeepsOldFileAndNoTemporary) {
   const fs::path dir = scratch("failed_write");
   fs::remove_all(dir);
@@ -605,7 +580,7 @@ TEST(TransferFile, FailedWriteKeepsOldFileAndNoTemporary) {
   // 64 KiB limit, 500 KB file.
   const TransferSet big = make_set(TransferKind::kGlossy, 4, 1, 500, prt::MaterialKind::kPhong, 8);
   {
-    FileSizeLimit limit(64 * 1024);
+    test_support::FileSizeLimit limit(64 * 1024);
     if (!limit.ok()) GTEST_SKIP() << "cannot lower RLIMIT_FSIZE here";
     try {
       prt::write_transfer(p, big);
