@@ -130,59 +130,6 @@ struct Layout {
   std::vector<std::uint32_t> order, row_of;
 };
 
-// The bounce passes, over the vertices in layout order: bounce b reads M^{b-1} of every
-// vertex through the row cache from the previous pass's scratch file, and the running sum
-// S^{b-1} block by block, and writes M^b (for the next bounce) and S^b = S^{b-1} + M^b: to a
-// scratch file, or, for the last bounce, row by row to its place in the output. The output
-// takes its rows out of order, rather than a last pass reading S^b back in index order to
-// append it: that pass wrote and read the whole payload once more.
-void stream_bounces(detail::BakeEngine& engine, const Layout& layout, int bounces,
-                    std::uint64_t block, const fs::path& path, const HitStore& hits,
-                    std::shared_ptr<Scratch> previous_pass, TransferFileWriter& writer) {
-  const std::uint64_t v = engine.vertex_count();
-  const std::size_t per_vertex = engine.floats_per_vertex();
-  const std::size_t row_bytes = per_vertex * sizeof(float);
-  std::shared_ptr<Scratch> previous_sum = previous_pass;  // S^0 = M^0
-  std::vector<float> current[2], sum(block * per_vertex);
-  for (std::vector<float>& c : current) c.resize(block * per_vertex);
-  std::vector<HitBlock> hit_blocks;
-  Overlap overlap;
-  for (int b = 1; b <= bounces; ++b) {
-    const bool last = b == bounces;
-    auto pass = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "bounce"));
-    auto running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
-    const Scratch& previous_rows = *previous_pass;
-    const detail::PassReader read = [&](std::uint64_t first, std::uint64_t rows, float* out) {
-      previous_rows.read(out, rows * row_bytes, first * row_bytes);
-    };
-    engine.start_pass(b);
-    for (std::uint64_t begin = 0, k = 0; begin < v; begin += block, ++k) {
-      const std::uint64_t end = std::min(v, begin + block), n = (end - begin) * per_vertex;
-      // Every block but the last has `block` vertices, so the same number of chunks.
-      const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
-      hits.load(begin / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      float* const m = current[k % 2].data();
-      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block, m);
-      // pass and running by value: an exception unwinds them before overlap waits.
-      overlap.run([&, pass, running, begin, end, n, m, last] {
-        previous_sum->read(sum.data(), n * sizeof(float), begin * per_vertex * sizeof(float));
-        for (std::size_t i = 0; i < n; ++i) sum[i] += m[i];
-        if (last) {
-          for (std::uint64_t i = begin; i < end; ++i)
-            writer.place(layout.order[i], sum.data() + (i - begin) * per_vertex, 1);
-        } else {
-          pass->write(m, n * sizeof(float));
-          running->write(sum.data(), n * sizeof(float));
-        }
-      });
-    }
-    overlap.wait();
-    engine.finish_pass();
-    previous_pass = pass;
-    previous_sum = running;
-  }
-}
-
 // A pass of every vertex in one file beside the output, which each rank of a distributed
 // bake writes its slice of and then maps whole. Not an AtomicFile: every rank opens the
 // same path. Reused across runs, since each run rewrites every byte it reads.
@@ -237,6 +184,80 @@ void shadow_in_layout_order(detail::BakeEngine& engine, const Layout& layout, st
   }
   overlap.wait();
   engine.finish_pass();
+}
+
+// Bounce pass `pass` over the layout's vertices [first, end), a block at a time: the engine
+// computes the block's M^b, reading M^(b-1) through `read`; then, on a task beside the next
+// block's computation, S^b = S^(b-1) + M^b (S^(b-1) read from `previous_sum`, whose row 0 is
+// vertex `first` of the layout) and store(M^b, S^b, begin, end).
+void bounce_in_layout_order(
+    detail::BakeEngine& engine, const Layout& layout, int pass, std::uint64_t first,
+    std::uint64_t end, std::uint64_t block, const HitStore& hits, const detail::PassReader& read,
+    const Scratch& previous_sum,
+    const std::function<void(const float*, const float*, std::uint64_t, std::uint64_t)>& store) {
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  // Every block but the last has `block` vertices, so the same number of chunks.
+  const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
+  std::vector<float> current[2], sum(std::min(block, end - first) * per_vertex);
+  for (std::vector<float>& c : current) c.resize(sum.size());
+  std::vector<HitBlock> hit_blocks;
+  Overlap overlap;
+  engine.start_pass(pass);
+  for (std::uint64_t begin = first, k = 0; begin < end; begin += block, ++k) {
+    const std::uint64_t stop = std::min(end, begin + block), n = (stop - begin) * per_vertex;
+    const std::uint64_t local = begin - first;
+    hits.load(local / block * chunks_per_block, (stop - begin + kChunk - 1) / kChunk, hit_blocks);
+    float* const m = current[k % 2].data();
+    engine.bounce(layout.block(begin, stop), hit_blocks, read, kGatherBlocks * block, m);
+    overlap.run([&, begin, stop, local, n, m] {
+      previous_sum.read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
+      for (std::size_t i = 0; i < n; ++i) sum[i] += m[i];
+      store(m, sum.data(), begin, stop);
+    });
+  }
+  overlap.wait();
+  engine.finish_pass();
+}
+
+// The last bounce's sums of the layout's vertices [begin, end), each row placed at its
+// vertex's index in the output: the output is in index order, the bounces in layout order.
+template <class Writer>
+void place_in_index_order(Writer& writer, const Layout& layout, const float* sums,
+                          std::uint64_t begin, std::uint64_t end, std::size_t per_vertex) {
+  for (std::uint64_t i = begin; i < end; ++i)
+    writer.place(layout.order[i], sums + (i - begin) * per_vertex, 1);
+}
+
+// The bounce passes of one process: bounce b reads M^(b-1) through the row cache from the
+// previous pass's scratch file, and writes M^b and S^b to scratch files, or, for the last
+// bounce, S^b row by row to its place in the output. (A last pass reading S^b back in index
+// order to append it wrote and read the whole payload once more.)
+void stream_bounces(detail::BakeEngine& engine, const Layout& layout, int bounces,
+                    std::uint64_t block, const fs::path& path, const HitStore& hits,
+                    std::shared_ptr<Scratch> previous_pass, TransferFileWriter& writer) {
+  const std::uint64_t v = engine.vertex_count();
+  const std::size_t per_vertex = engine.floats_per_vertex();
+  const std::size_t row_bytes = per_vertex * sizeof(float);
+  std::shared_ptr<Scratch> previous_sum = previous_pass;  // S^0 = M^0
+  for (int b = 1; b <= bounces; ++b) {
+    const bool last = b == bounces;
+    auto pass = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "bounce"));
+    auto running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
+    const Scratch& previous_rows = *previous_pass;
+    const detail::PassReader read = [&](std::uint64_t first, std::uint64_t rows, float* out) {
+      previous_rows.read(out, rows * row_bytes, first * row_bytes);
+    };
+    bounce_in_layout_order(
+        engine, layout, b, 0, v, block, hits, read, *previous_sum,
+        [&](const float* m, const float* sum, std::uint64_t begin, std::uint64_t end) {
+          const std::uint64_t bytes = (end - begin) * row_bytes;
+          if (last) return place_in_index_order(writer, layout, sum, begin, end, per_vertex);
+          pass->write(m, bytes);
+          running->write(sum, bytes);
+        });
+    previous_pass = pass;
+    previous_sum = running;
+  }
 }
 
 // The shadow pass of vertices [first, end) in index order, appended to `writer` a block at a
@@ -299,11 +320,6 @@ TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::
                          });
   engine.end_tracing();
   barrier();  // every rank's M^0 is in passes[0]
-  std::vector<float> current[2], sum(block * per_vertex);
-  for (std::vector<float>& c : current) c.resize(block * per_vertex);
-  std::vector<HitBlock> hit_blocks;
-  const std::uint64_t chunks_per_block = (block + kChunk - 1) / kChunk;
-  Overlap overlap;
   for (int b = 1; b <= o.bounces; ++b) {
     const bool last = b == o.bounces;
     auto next_running = last ? nullptr : std::make_shared<Scratch>(scratch_target(path, "sum"));
@@ -314,30 +330,16 @@ TransferSet bake_rank(const meshes::Mesh& mesh, const BakeOptions& o, const fs::
     const detail::PassReader read = [&](std::uint64_t first, std::uint64_t rows, float* out) {
       previous.read(out, rows * row_bytes, first * row_bytes);
     };
-    engine.start_pass(b);
-    for (std::uint64_t begin = range.first, k = 0; begin < range.end; begin += block, ++k) {
-      const std::uint64_t end = std::min(range.end, begin + block), n = (end - begin) * per_vertex;
-      const std::uint64_t local = begin - range.first;
-      hits.load(local / block * chunks_per_block, (end - begin + kChunk - 1) / kChunk, hit_blocks);
-      float* const m = current[k % 2].data();
-      engine.bounce(layout.block(begin, end), hit_blocks, read, kGatherBlocks * block, m);
-      // The shared pointers and b by value: an exception unwinds them before overlap waits.
-      overlap.run([&, running, next_running, b, begin, end, local, n, m, last] {
-        running->read(sum.data(), n * sizeof(float), local * per_vertex * sizeof(float));
-        for (std::size_t i = 0; i < n; ++i) sum[i] += m[i];
-        if (last) {
-          // The sums go straight to their place in the output, from this rank's range of
-          // the layout: the ranks' ranges together are every vertex once.
-          for (std::uint64_t i = begin; i < end; ++i)
-            writer.place(layout.order[i], sum.data() + (i - begin) * per_vertex, 1);
-        } else {
+    // The last sums go straight to their place in the output: the ranks' ranges of the
+    // layout together are every vertex once.
+    bounce_in_layout_order(
+        engine, layout, b, range.first, range.end, block, hits, read, *running,
+        [&](const float* m, const float* sum, std::uint64_t begin, std::uint64_t end) {
+          const std::uint64_t n = (end - begin) * per_vertex;
+          if (last) return place_in_index_order(writer, layout, sum, begin, end, per_vertex);
           passes[b % 2].write(m, n, begin * per_vertex);
-          next_running->write(sum.data(), n * sizeof(float));
-        }
-      });
-    }
-    overlap.wait();
-    engine.finish_pass();
+          next_running->write(sum, n * sizeof(float));
+        });
     running = next_running;
     // Every rank's M^b is written, and nobody reads M^(b-1) any more, whose file pass b + 1
     // overwrites.
