@@ -591,13 +591,24 @@ void interpolate_corners(const float* const corners[3], const float* y, const fl
   }
 }
 
+// The same through Eigen's product, one corner at a time: for the widths whose rounding the
+// kernel does not reproduce.
+void interpolate_corners_eigen(const float* const corners[3], const float* y, const float beta[3],
+                               int n, float* out) {
+  Eigen::Map<Eigen::RowVectorXf> row(out, n);
+  for (int c = 0; c < 3; ++c) {
+    row.noalias() += beta[c] * (Eigen::Map<const Eigen::VectorXf>(y + c * n, n).transpose() *
+                                Eigen::Map<const RowMatF>(corners[c], n, n));
+  }
+}
+
 using InterpolateCorners = void (*)(const float* const[3], const float*, const float[3], int,
                                     float*);
 
 // The kernel for n coefficients, unrolled for the orders a glossy bake is usually run at.
-// Null where Eigen would round differently: it finishes a row count that is not a multiple
-// of 4 (odd orders) with scalar code, which this translation unit does not contract into
-// fused multiply-adds.
+// Eigen's own product where it would round differently: it finishes a row count that is not
+// a multiple of 4 (odd orders) with scalar code, which this translation unit does not
+// contract into fused multiply-adds.
 InterpolateCorners corner_interpolation(int n) {
   switch (n) {
     case 16:
@@ -607,7 +618,7 @@ InterpolateCorners corner_interpolation(int n) {
     case 64:
       return interpolate_corners<64>;
     default:
-      return n % 4 == 0 ? interpolate_corners<0> : nullptr;
+      return n % 4 == 0 ? interpolate_corners<0> : interpolate_corners_eigen;
   }
 }
 
@@ -623,17 +634,11 @@ void hit_radiance_rows(const BakeContext& ctx, BounceScratch& s, const BounceSou
     const float beta[3] = {1.f - hits[h].u - hits[h].v, hits[h].u, hits[h].v};
     const float* corners[3];
     for (int c = 0; c < 3; ++c) corners[c] = src.row(tri[c]) + ch * src.per_channel;
-    if (ctx.glossy && interpolate) {
+    if (ctx.glossy) {
       interpolate(corners, s.corner_y.col(3 * h).data(), beta, n, s.rows.row(h).data());
     } else {
-      for (int c = 0; c < 3; ++c) {
-        if (ctx.glossy) {
-          s.rows.row(h).noalias() += beta[c] * (s.corner_y.col(3 * h + c).transpose() *
-                                                Eigen::Map<const RowMatF>(corners[c], n, n));
-        } else {
-          s.rows.row(h) += beta[c] * Eigen::Map<const Eigen::RowVectorXf>(corners[c], n);
-        }
-      }
+      for (int c = 0; c < 3; ++c)
+        s.rows.row(h) += beta[c] * Eigen::Map<const Eigen::RowVectorXf>(corners[c], n);
     }
   }
 }

@@ -409,12 +409,13 @@ void check_finite(const fs::path& file, const TransferSet& shape, const float* d
   }
 }
 
-// The floats of rows [first_vertex, first_vertex + count) of `shape`, after checking that they
-// are in the mesh, fit the `remaining` floats of the writer and are finite (messages name
-// `file`).
-std::uint64_t checked_rows(const fs::path& file, const TransferSet& shape,
-                           std::uint64_t first_vertex, const float* data, std::uint64_t count,
-                           std::uint64_t remaining) {
+// Writes rows [first_vertex, first_vertex + count) of `shape` at their place in the transfer
+// file open at fd (named `file` in messages, `written` when the write fails), after checking
+// that they are in the mesh, fit the `remaining` floats of the writer and are finite. Returns
+// the floats written.
+std::uint64_t place_rows(int fd, const fs::path& file, const fs::path& written,
+                         const TransferSet& shape, std::uint64_t first_vertex, const float* data,
+                         std::uint64_t count, std::uint64_t remaining) {
   if (first_vertex > shape.vertex_count || count > shape.vertex_count - first_vertex) {
     throw std::invalid_argument(file.string() + ": cannot write the transfer set: vertices [" +
                                 std::to_string(first_vertex) + ", " +
@@ -426,7 +427,10 @@ std::uint64_t checked_rows(const fs::path& file, const TransferSet& shape,
         file.string() + ": cannot write the transfer set: " + std::to_string(floats) +
         " floats placed with " + std::to_string(remaining) + " left to write");
   }
-  check_finite(file, shape, data, floats, first_vertex * shape.floats_per_vertex());
+  const std::uint64_t first = first_vertex * shape.floats_per_vertex();
+  check_finite(file, shape, data, floats, first);
+  common::write_exact(fd, data, floats * sizeof(float), kHeaderBytes + first * sizeof(float),
+                      written.c_str());
   return floats;
 }
 }  // namespace
@@ -448,19 +452,14 @@ void TransferFileWriter::append(const float* data, std::size_t floats) {
 void TransferFileWriter::place(std::uint64_t first_vertex, const float* data, std::uint64_t count) {
   if (written_ > 0 && place_fd_ < 0)
     throw std::logic_error("TransferFileWriter: place() after append() on the same file");
-  const fs::path& temporary = file_->temporary();
-  const std::uint64_t floats =
-      checked_rows(file_->target(), shape_, first_vertex, data, count, expected_ - written_);
   if (place_fd_ < 0) {
-    place_fd_ = ::open(temporary.c_str(), O_RDWR | O_CLOEXEC);
+    place_fd_ = ::open(file_->temporary().c_str(), O_RDWR | O_CLOEXEC);
     if (place_fd_ < 0)
       throw common::IoError(file_->target().string() + ": cannot reopen the temporary file (" +
                             std::strerror(errno) + ")");
   }
-  common::write_exact(place_fd_, data, floats * sizeof(float),
-                      kHeaderBytes + first_vertex * shape_.floats_per_vertex() * sizeof(float),
-                      temporary.c_str());
-  written_ += floats;
+  written_ += place_rows(place_fd_, file_->target(), file_->temporary(), shape_, first_vertex, data,
+                         count, expected_ - written_);
 }
 
 void TransferFileWriter::commit() {
@@ -529,13 +528,9 @@ void TransferSliceWriter::place(std::uint64_t first_vertex, const float* data,
                                 std::uint64_t count) {
   if (written_ > 0 && !placed_)
     throw std::logic_error("TransferSliceWriter: place() after append()");
-  const std::uint64_t floats =
-      checked_rows(partial_, shape_, first_vertex, data, count, expected_ - written_);
+  written_ +=
+      place_rows(fd_, partial_, partial_, shape_, first_vertex, data, count, expected_ - written_);
   placed_ = true;
-  common::write_exact(fd_, data, floats * sizeof(float),
-                      kHeaderBytes + first_vertex * shape_.floats_per_vertex() * sizeof(float),
-                      partial_.c_str());
-  written_ += floats;
 }
 
 void TransferSliceWriter::close() {
