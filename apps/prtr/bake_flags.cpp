@@ -58,6 +58,16 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
   cmd->add_option("--f0", f.bake.material.f0,
                   "Cook-Torrance Fresnel reflectance at normal incidence")
       ->capture_default_str();
+  cmd->add_option("--masking", f.masking,
+                  "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the "
+                  "thesis's)")
+      ->check(CLI::IsMember({"smith", "v-groove"}))
+      ->capture_default_str();
+  cmd->add_option("--view-fit", f.view_fit,
+                  "Glossy: how the view side fits exit radiance; hemisphere is the thesis's "
+                  "projection (docs/ARCHITECTURE.md, \"The view side\")")
+      ->check(CLI::IsMember({"least-squares", "even", "hemisphere"}))
+      ->capture_default_str();
   cmd->add_option("--ray-offset", f.bake.ray_offset,
                   "Rays start a tenth of this x the bbox diagonal into the face they leave through")
       ->capture_default_str();
@@ -68,6 +78,8 @@ prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
   bake.kind = f.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;
   bake.material.kind = prt::parse_material(f.material);
   bake.material.albedo = parse_albedo(f.albedo);
+  bake.material.masking = prt::parse_masking(f.masking);
+  bake.view_fit = prt::parse_view_fit(f.view_fit);
   // A flag the chosen material never reads is a mistake worth reporting.
   const auto kind = bake.material.kind;
   auto unused = [&](const char* flag, bool used) {
@@ -78,6 +90,9 @@ prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
   unused("--exponent", kind == prt::MaterialKind::kPhong);
   unused("--roughness", kind == prt::MaterialKind::kCookTorrance);
   unused("--f0", kind == prt::MaterialKind::kCookTorrance);
+  unused("--masking", kind == prt::MaterialKind::kCookTorrance);
+  if (f.command && f.command->count("--view-fit") && f.kind == "diffuse")
+    throw UsageError("--view-fit applies to --kind glossy only");
   unused("--specular", kind != prt::MaterialKind::kLambert);
   if (kind == prt::MaterialKind::kLambert) bake.material.specular = 0.f;
   try {

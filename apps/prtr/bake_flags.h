@@ -1,5 +1,5 @@
 // apps/prtr/bake_flags.h: the bake flags (--kind, --order, --samples, --bounces, --seed,
-// --material and its parameters, --ray-offset), shared by every command that bakes: prtr bake,
+// --material and its parameters, --masking, --view-fit, --ray-offset), shared by every command that bakes: prtr bake,
 // and prtr relight / overdraw through the cache.
 #pragma once
 
@@ -13,6 +13,7 @@ namespace prtr_app {
 
 struct BakeFlags {
   std::string kind = "glossy", material = "phong", albedo = "0.5";
+  std::string masking = "smith", view_fit = "least-squares";
   prt::BakeOptions bake;
   CLI::App* command = nullptr;  // to tell which flags were given
 };

@@ -68,9 +68,11 @@ void describe_transfer(const std::string& path, const std::string& mesh, bool ve
               static_cast<unsigned long long>(set.seed));
   std::printf(
       "material    %s, albedo (%g, %g, %g), specular %g, exponent %g, roughness %g, "
-      "f0 %g\n",
+      "f0 %g, masking %s\n",
       prt::material_name(m.kind), m.albedo.x(), m.albedo.y(), m.albedo.z(), m.specular, m.exponent,
-      m.roughness, m.f0);
+      m.roughness, m.f0, prt::masking_name(m.masking));
+  if (set.kind == prt::TransferKind::kGlossy)
+    std::printf("view fit    %s\n", prt::view_fit_name(set.view_fit));
   std::printf("mesh hash   %016llx\n", static_cast<unsigned long long>(set.mesh_hash));
   if (verify) std::printf("payload     checksum and values verified\n");
   if (!mesh.empty()) {

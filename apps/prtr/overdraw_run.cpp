@@ -82,7 +82,8 @@ std::string describe_bake(const prt::TransferSet& t) {
     << t.material.albedo.x() << ", specular " << t.material.specular;
   if (t.material.kind == prt::MaterialKind::kPhong) b << ", exponent " << t.material.exponent;
   if (t.material.kind == prt::MaterialKind::kCookTorrance)
-    b << ", roughness " << t.material.roughness << ", f0 " << t.material.f0;
+    b << ", roughness " << t.material.roughness << ", f0 " << t.material.f0 << ", "
+      << prt::masking_name(t.material.masking) << " masking";
   b << "), " << t.samples << " samples, " << t.bounces << " bounce(s)";
   return b.str();
 }

@@ -201,7 +201,9 @@ Setup make_setup(const BakeOptions& o, int channels, double* brdf_seconds) {
     const auto start = Clock::now();
     for (int c = 0; c < channels; ++c) {
       s.brdf.push_back(o.brdf_override ? o.brdf_override->cast<float>().eval()
-                                       : brdf_matrix(o.material, o.order, c).cast<float>().eval());
+                                       : brdf_matrix(o.material, o.order, c, {}, o.view_fit)
+                                             .cast<float>()
+                                             .eval());
     }
     *brdf_seconds = seconds_since(start);
   }
@@ -226,6 +228,11 @@ void validate(const BakeOptions& o) {
         std::to_string(o.ray_offset));
   }
   o.material.validate();
+  if (!view_fit_renderable(o.view_fit)) {
+    throw std::invalid_argument(std::string("--view-fit ") + view_fit_name(o.view_fit) +
+                                " is for the benchmarks only; bake with least-squares, even or "
+                                "hemisphere");
+  }
   const int n = sh_count(o.order);
   if (o.brdf_override && (o.brdf_override->rows() != n || o.brdf_override->cols() != n)) {
     throw std::invalid_argument("BRDF matrix override must be " + std::to_string(n) + " x " +
@@ -545,8 +552,10 @@ void corner_view_directions(const BakeContext& ctx, BounceScratch& s, const Boun
     const meshes::Triangle& tri = ctx.mesh.triangles[hits[h].triangle];
     for (int c = 0; c < 3; ++c) {
       const CornerFrame& f = src.frames[src.row_index(tri[c])];
-      s.corner_dirs.col(3 * h + c) << f.tangent.dot(back), f.bitangent.dot(back),
-          f.normal.dot(back);
+      // A corner whose normal leans away from p sees p below its own horizon: it sends what
+      // it sends toward its horizon (prt/view_fit.h), not the fit's extension below it.
+      s.corner_dirs.col(3 * h + c) = clamp_to_horizon(
+          Eigen::Vector3f(f.tangent.dot(back), f.bitangent.dot(back), f.normal.dot(back)));
     }
   }
   sh_eval_batch(ctx.options.order, s.corner_dirs.leftCols(3 * count), s.corner_batch);
@@ -760,6 +769,7 @@ TransferSet BakeEngine::shape() const {
   out.bounces = o.bounces;
   out.seed = o.seed;
   out.material = o.material;
+  out.view_fit = o.view_fit;
   out.mesh_hash = meshes::content_hash(ctx.mesh);
   return out;
 }

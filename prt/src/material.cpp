@@ -2,11 +2,13 @@
 // materials). Models: Lambert; the energy-normalised "modified Phong" of Lafortune & Willems,
 // "Using the modified Phong reflectance model for physically based rendering" (1994);
 // Cook & Torrance, "A reflectance model for computer graphics" (ACM TOG 1, 1982) with the
-// Beckmann distribution and their V-groove masking term; Schlick, "An inexpensive BRDF model
-// for physically-based rendering" (1994) for the Fresnel factor.
+// Beckmann distribution and either their V-groove masking term or Smith's height-correlated
+// one (Heitz, JCGT 2014); Schlick, "An inexpensive BRDF model for physically-based
+// rendering" (1994) for the Fresnel factor.
 //
 // The BRDF matrix is a product quadrature over view and light hemispheres:
-//     B = Yv diag(wv) F Ys^T,  F(a, b) = f_r(v_a, s_b) s_b.z w_b,
+//     B = P F Ys^T,  F(a, b) = f_r(v_a, s_b) s_b.z w_b,
+// with P the view fit's projection (prt/view_fit.h; Yv diag(wv) for the thesis's),
 // with Gauss-Legendre nodes in cos(theta) on (0, 1) and midpoint nodes in phi. View nodes are
 // split into fixed chunks (independent of the thread count) that run in parallel, each with
 // its own partial B; the partials are summed in chunk order, so the result is deterministic.
@@ -37,7 +39,17 @@ constexpr double kPi = std::numbers::pi;
 struct Lobe {
   MaterialKind kind;
   double rho_d, rho_s, exponent, m2, f0;
+  Masking masking;
 };
+
+// Smith's Lambda for Beckmann at a direction with cosine z (0 < z <= 1), roughness^2 m2.
+double smith_lambda(double z, double m2) {
+  if (z >= 1.0) return 0.0;
+  const double a = z / std::sqrt(m2 * (1.0 - z * z));
+  // Past a = 8 both terms are below 1e-28 of 1: exp(-64) and erfc(8) ~ 1e-29.
+  if (a > 8.0) return 0.0;
+  return 0.5 * (std::erf(a) - 1.0) + std::exp(-a * a) / (2.0 * a * std::sqrt(kPi));
+}
 
 Lobe make_lobe(const Material& material, int channel) {
   double rho_d = material.albedo.x();
@@ -49,8 +61,8 @@ Lobe make_lobe(const Material& material, int channel) {
     rho_d = material.albedo[channel];
   }
   const double m = material.roughness;
-  return {material.kind,      rho_d, double(material.specular), double(material.exponent), m * m,
-          double(material.f0)};
+  return {material.kind, rho_d,        double(material.specular), double(material.exponent),
+          m * m,         double(material.f0), material.masking};
 }
 
 // The header's formulas. v and s are unit vectors in the local frame.
@@ -77,7 +89,10 @@ double eval(const Lobe& lobe, const Eigen::Vector3d& v, const Eigen::Vector3d& s
       const double hz2 = hz * hz;
       const double tan2 = (1.0 - hz2) / hz2;
       const double d = std::exp(-tan2 / lobe.m2) / (kPi * lobe.m2 * hz2 * hz2);
-      const double g = std::min({1.0, 2.0 * hz * v.z() / vh, 2.0 * hz * s.z() / vh});
+      const double g =
+          lobe.masking == Masking::kSmith
+              ? 1.0 / (1.0 + smith_lambda(v.z(), lobe.m2) + smith_lambda(s.z(), lobe.m2))
+              : std::min({1.0, 2.0 * hz * v.z() / vh, 2.0 * hz * s.z() / vh});
       const double c = 1.0 - vh, c2 = c * c;
       const double f = lobe.f0 + (1.0 - lobe.f0) * c2 * c2 * c;
       return diffuse + lobe.rho_s * d * g * f / (4.0 * v.z() * s.z());
@@ -89,6 +104,7 @@ double eval(const Lobe& lobe, const Eigen::Vector3d& v, const Eigen::Vector3d& s
 // The light grid's coordinates as separate arrays, for eval_row.
 struct LightArrays {
   Eigen::ArrayXd x, y, z, inv_z;
+  Eigen::ArrayXd smith;  // 1 + Lambda(s) (Cook-Torrance with Smith masking), else empty
 };
 
 // f_r(v, s_b) for all light nodes s_b at once: the same formulas as eval(), written on Eigen
@@ -119,7 +135,9 @@ void eval_row(const Lobe& lobe, const Eigen::Vector3d& v, const LightArrays& s, 
   const Eigen::ArrayXd p = v.z() + s.z;
   const Eigen::ArrayXd u = 2.0 * q / p.square();
   const Eigen::ArrayXd d = ((1.0 - u) / lobe.m2).exp() * u.square() / (kPi * lobe.m2);
-  const Eigen::ArrayXd g = (2.0 * p * s.z.min(v.z()) / q).min(1.0);
+  const Eigen::ArrayXd g = lobe.masking == Masking::kSmith
+                               ? (s.smith + smith_lambda(v.z(), lobe.m2)).inverse().eval()
+                               : (2.0 * p * s.z.min(v.z()) / q).min(1.0).eval();
   const Eigen::ArrayXd c = 1.0 - (0.5 * q).sqrt();
   const Eigen::ArrayXd f = lobe.f0 + (1.0 - lobe.f0) * c.square().square() * c;
   row = diffuse + (lobe.rho_s / (4.0 * v.z())) * d * g * f * s.inv_z;
@@ -239,6 +257,19 @@ MaterialKind parse_material(const std::string& name) {
   return common::parse_enum<MaterialKind>(kMaterialNames, name, "material");
 }
 
+namespace {
+constexpr common::EnumName<Masking> kMaskingNames[] = {{Masking::kSmith, "smith"},
+                                                       {Masking::kVGroove, "v-groove"}};
+}  // namespace
+
+const char* masking_name(Masking masking) {
+  return common::enum_name<Masking>(kMaskingNames, masking);
+}
+
+Masking parse_masking(const std::string& name) {
+  return common::parse_enum<Masking>(kMaskingNames, name, "masking");
+}
+
 double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,
                  const Eigen::Vector3d& s) {
   return eval(make_lobe(material, channel), v, s);
@@ -322,7 +353,7 @@ BrdfQuadrature resolve_brdf_quadrature(const Material& material, int order,
 }
 
 Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
-                            const BrdfQuadrature& quadrature) {
+                            const BrdfQuadrature& quadrature, ViewFit fit, double view_lambda) {
   material.validate();
   const Lobe lobe = make_lobe(material, channel);
   const BrdfQuadrature q = resolve_brdf_quadrature(material, order, quadrature);
@@ -333,8 +364,8 @@ Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
   const Eigen::Index view_count = view.directions.cols();
   const Eigen::Index light_count = light.directions.cols();
 
-  ShBatchD y_view, y_light;
-  sh_eval_batch(order, view.directions, y_view);
+  const Eigen::MatrixXd view_side = view_projection(fit, order, view.directions, view.weights, view_lambda);
+  ShBatchD y_light;
   sh_eval_batch(order, light.directions, y_light);
   // Ys diag(s.z w)^T, light_count x n: the light side of every product, folded once.
   const Eigen::MatrixXd light_side =
@@ -342,10 +373,15 @@ Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
        (light.directions.row(2).transpose().array() * light.weights.array()).transpose())
           .matrix()
           .transpose();
-  const LightArrays light_arrays{light.directions.row(0).transpose().array(),
-                                 light.directions.row(1).transpose().array(),
-                                 light.directions.row(2).transpose().array(),
-                                 light.directions.row(2).transpose().array().inverse()};
+  LightArrays light_arrays{light.directions.row(0).transpose().array(),
+                           light.directions.row(1).transpose().array(),
+                           light.directions.row(2).transpose().array(),
+                           light.directions.row(2).transpose().array().inverse(),
+                           {}};
+  if (lobe.kind == MaterialKind::kCookTorrance && lobe.masking == Masking::kSmith) {
+    light_arrays.smith = light_arrays.z.unaryExpr(
+        [&](double z) { return 1.0 + smith_lambda(z, lobe.m2); });
+  }
 
   // Work unit: kViewChunk view nodes against all light nodes, in blocks of kLightBlock so
   // that a block of F (256 KB) and of light_side (~600 KB at order 6) stay in cache while
@@ -365,31 +401,42 @@ Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
       block.y = light_arrays.y.segment(b0, width);
       block.z = light_arrays.z.segment(b0, width);
       block.inv_z = light_arrays.inv_z.segment(b0, width);
+      if (light_arrays.smith.size()) block.smith = light_arrays.smith.segment(b0, width);
       f.resize(size, width);
       for (Eigen::Index a = 0; a < size; ++a) {
         eval_row(lobe, view.directions.col(begin + a), block, f.row(a).data());
       }
       f_light.noalias() += f * light_side.middleRows(b0, width);
     }
-    partial[c] = (y_view.middleCols(begin, size).array().rowwise() *
-                  view.weights.segment(begin, size).transpose().array())
-                     .matrix() *
-                 f_light;
+    partial[c] = view_side.middleCols(begin, size) * f_light;
   });
   Eigen::MatrixXd total = Eigen::MatrixXd::Zero(n, n);
   for (const Eigen::MatrixXd& p : partial) total += p;
   return total;
 }
 
-Eigen::MatrixXd lambert_brdf_matrix(double albedo, int order) {
+Eigen::MatrixXd lambert_brdf_matrix(double albedo, int order, ViewFit fit) {
   check_order(order, "BRDF matrix order");
   if (!(albedo >= 0.0 && albedo <= 1.0)) {
     throw std::invalid_argument(range_error("--albedo", "[0, 1]", albedo));
   }
   // a_l = int_{z>0} y_l^0 (coefficients of the hemisphere indicator, cos^0) and b_l =
   // int_{z>0} z y_l^0 (the clamped cosine): B_ij = (rho / pi) a_i b_j on m = 0 entries.
-  const Eigen::VectorXd a = zonal_cosine_power(order, 0.0);
   const Eigen::VectorXd b = zonal_cosine_power(order, 1.0);
+  // The view side: the fit of the constant 1 on the upper hemisphere.
+  Eigen::VectorXd a = Eigen::VectorXd::Zero(order);
+  switch (fit) {
+    case ViewFit::kHemisphere:
+      a = zonal_cosine_power(order, 0.0);
+      break;
+    case ViewFit::kEven:
+    case ViewFit::kLeastSquares:
+      a[0] = std::sqrt(4.0 * kPi);
+      break;
+    case ViewFit::kHemisphericalHarmonics:
+      a[0] = std::sqrt(2.0 * kPi);
+      break;
+  }
   const int n = sh_count(order);
   Eigen::MatrixXd result = Eigen::MatrixXd::Zero(n, n);
   for (int li = 0; li < order; ++li) {
@@ -398,6 +445,33 @@ Eigen::MatrixXd lambert_brdf_matrix(double albedo, int order) {
     }
   }
   return result;
+}
+
+}  // namespace prt
+
+namespace prt {
+
+double directional_albedo(const Material& material, int channel, const Eigen::Vector3d& v) {
+  material.validate();
+  const Lobe lobe = make_lobe(material, channel);
+  // A dense grid, deliberately unlike brdf_matrix's: midpoints in theta (not Gauss-Legendre
+  // in cos theta) around the mirror direction's azimuth. 1024 x 2048 nodes resolve a Phong
+  // lobe of exponent ~10^4 or a Beckmann lobe of m = 0.05 with several nodes across.
+  constexpr int kTheta = 1024, kPhi = 2048;
+  const double phi_v = std::atan2(v.y(), v.x());
+  double total = 0.0;
+  for (int t = 0; t < kTheta; ++t) {
+    const double theta = 0.5 * kPi * (t + 0.5) / kTheta;
+    const double z = std::cos(theta), r = std::sin(theta);
+    const double weight = (0.5 * kPi / kTheta) * (2.0 * kPi / kPhi) * r * z;  // dOmega s.z
+    double ring = 0.0;
+    for (int p = 0; p < kPhi; ++p) {
+      const double phi = phi_v + kPi + 2.0 * kPi * (p + 0.5) / kPhi;
+      ring += eval(lobe, v, Eigen::Vector3d(r * std::cos(phi), r * std::sin(phi), z));
+    }
+    total += weight * ring;
+  }
+  return total;
 }
 
 }  // namespace prt

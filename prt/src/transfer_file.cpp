@@ -1,4 +1,4 @@
-// The .prtx transfer file, version 1. docs/FORMATS.md ("Transfer file (.prtx), version 1")
+// The .prtx transfer file, version 2. docs/FORMATS.md ("Transfer file (.prtx), version 2")
 // is the byte-by-byte description; the offsets below must stay in step with its table.
 //
 // The header is serialised field by field at fixed offsets (never by writing a struct, whose
@@ -63,10 +63,11 @@ constexpr std::size_t kOffSpecular = 76;          // f32
 constexpr std::size_t kOffExponent = 80;          // f32
 constexpr std::size_t kOffRoughness = 84;         // f32
 constexpr std::size_t kOffF0 = 88;                // f32
-constexpr std::size_t kOffReserved0 = 92;         // u32, zero
+constexpr std::size_t kOffViewFit = 92;           // u32 (version 2; was reserved)
 constexpr std::size_t kOffPayloadFloats = 96;     // u64
 constexpr std::size_t kOffPayloadChecksum = 104;  // u64
-constexpr std::size_t kOffReserved1 = 112;        // u64, zero
+constexpr std::size_t kOffMasking = 112;          // u32 (version 2; was reserved)
+constexpr std::size_t kOffReserved = 116;         // u32, zero
 constexpr std::size_t kOffHeaderChecksum = 120;   // u64, FNV-1a of bytes [0, 120)
 static_assert(kOffHeaderChecksum + 8 == kHeaderBytes);
 
@@ -97,6 +98,7 @@ std::string num(float v) {
 // (u32/u64 from disk) share one check.
 struct Fields {
   std::int64_t kind = 0, order = 0, channels = 0, samples = 0, bounces = 0, material_kind = 0;
+  std::int64_t view_fit = 0, masking = 0;
   std::uint64_t vertex_count = 0;
   float albedo[3] = {0, 0, 0};
   float specular = 0, exponent = 0, roughness = 0, f0 = 0;
@@ -110,6 +112,8 @@ Fields fields_of(const TransferSet& set) {
   f.samples = set.samples;
   f.bounces = set.bounces;
   f.material_kind = static_cast<std::int64_t>(set.material.kind);
+  f.view_fit = static_cast<std::int64_t>(set.view_fit);
+  f.masking = static_cast<std::int64_t>(set.material.masking);
   f.vertex_count = set.vertex_count;
   for (int c = 0; c < 3; ++c) f.albedo[c] = set.material.albedo[c];
   f.specular = set.material.specular;
@@ -139,6 +143,10 @@ std::string field_problem(const Fields& f) {
   if (f.bounces < 0 || f.bounces > kMaxBounces) return out("bounce count", f.bounces, "0 to 16");
   if (f.material_kind < 0 || f.material_kind > 2)
     return out("material kind", f.material_kind, "0 lambert, 1 phong, 2 cook-torrance");
+  // Only fits the renderers evaluate are baked; the benchmarks' HSH never reaches a file.
+  if (f.view_fit < 0 || f.view_fit > 2)
+    return out("view fit", f.view_fit, "0 hemisphere, 1 even, 2 least-squares");
+  if (f.masking < 0 || f.masking > 1) return out("masking", f.masking, "0 smith, 1 v-groove");
   if (f.vertex_count > kMaxVertexCount) {
     return "vertex count " + std::to_string(f.vertex_count) + " out of range (at most 2^40)";
   }
@@ -200,6 +208,7 @@ TransferSet without_payload(const TransferSet& set) {
   s.bounces = set.bounces;
   s.seed = set.seed;
   s.material = set.material;
+  s.view_fit = set.view_fit;
   s.mesh_hash = set.mesh_hash;
   s.payload_checksum = set.payload_checksum;
   return s;
@@ -224,6 +233,9 @@ Header encode_header(const TransferSet& set, std::uint64_t payload_floats,
   common::put_field<float>(h, kOffExponent, set.material.exponent);
   common::put_field<float>(h, kOffRoughness, set.material.roughness);
   common::put_field<float>(h, kOffF0, set.material.f0);
+  common::put_field<std::uint32_t>(h, kOffViewFit, static_cast<std::uint32_t>(set.view_fit));
+  common::put_field<std::uint32_t>(h, kOffMasking,
+                                   static_cast<std::uint32_t>(set.material.masking));
   common::put_field<std::uint64_t>(h, kOffPayloadFloats, payload_floats);
   common::put_field<std::uint64_t>(h, kOffPayloadChecksum, payload_checksum);
   common::seal_header(h);
@@ -249,11 +261,12 @@ TransferSet decode(const Header& h, const std::string& name, std::uint64_t* payl
   f.exponent = common::get_field<float>(h, kOffExponent);
   f.roughness = common::get_field<float>(h, kOffRoughness);
   f.f0 = common::get_field<float>(h, kOffF0);
+  f.view_fit = common::get_field<std::uint32_t>(h, kOffViewFit);
+  f.masking = common::get_field<std::uint32_t>(h, kOffMasking);
   if (const std::string problem = field_problem(f); !problem.empty()) {
     throw fail(problem + " in the header; the file is damaged: " + kRebake);
   }
-  if (common::get_field<std::uint32_t>(h, kOffReserved0) != 0 ||
-      common::get_field<std::uint64_t>(h, kOffReserved1) != 0) {
+  if (common::get_field<std::uint32_t>(h, kOffReserved) != 0) {
     throw fail("reserved header bytes are not zero; the file is damaged: " + std::string(kRebake));
   }
 
@@ -273,6 +286,8 @@ TransferSet decode(const Header& h, const std::string& name, std::uint64_t* payl
   set.material.exponent = f.exponent;
   set.material.roughness = f.roughness;
   set.material.f0 = f.f0;
+  set.material.masking = static_cast<Masking>(f.masking);
+  set.view_fit = static_cast<ViewFit>(f.view_fit);
 
   // Sizes: vertex_count <= 2^40 and floats_per_vertex <= 3 * 100 * 100, so the product fits
   // in 64 bits; the checks stay in case either limit grows.

@@ -41,7 +41,14 @@ const char* kLocalView =
     "  vec3 t_ = normalize(a_tangent);\n"
     "  vec3 b_ = cross(n_, t_);\n"
     "  vec3 v_ = normalize(u_eye - a_position);\n"
-    "  vec3 d = vec3(dot(v_, t_), dot(v_, b_), dot(v_, n_));\n";
+    "  vec3 d = vec3(dot(v_, t_), dot(v_, b_), dot(v_, n_));\n"
+    // A view below the vertex's horizon (a silhouette: the interpolated surface still faces
+    // the eye) takes the radiance of its most grazing view above it (prt/view_fit.h,
+    // clamp_to_horizon): the fit is defined up to the horizon, its extension is not.
+    "  if (d.z < 0.0) {\n"
+    "    float t_len_ = length(d.xy);\n"
+    "    d = t_len_ > 0.0 ? vec3(d.xy / t_len_, 0.0) : vec3(1.0, 0.0, 0.0);\n"
+    "  }\n";
 
 }  // namespace
 
@@ -146,9 +153,7 @@ std::string compressed_vertex_shader(const ConstantLayout& layout, ConstantAcces
     }
     o << ");\n";
   }
-  // Below the local horizon the truncated glossy lobe rings negative; nothing leaves there.
-  o << (layout.glossy ? "  v_radiance = d.z > 0.0 ? r : vec3(0.0);\n}\n"
-                      : "  v_radiance = r;\n}\n");
+  o << "  v_radiance = r;\n}\n";
   return o.str();
 }
 
@@ -175,7 +180,6 @@ std::string uncompressed_vertex_shader(int order, bool glossy) {
       o << (i ? " + " : "") << "y" << i << " * e_[base_ + " << c * rows + i << "]";
   }
   o << ");\n";
-  if (glossy) o << "  if (d.z <= 0.0) v_radiance = vec3(0.0);\n";  // below the horizon
   o << "}\n";
   return o.str();
 }

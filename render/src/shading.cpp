@@ -1,6 +1,7 @@
 #include "render/shading.h"
 
 #include "prt/sh.h"
+#include "prt/view_fit.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -91,8 +92,9 @@ void ShadingConstants::compute(const Eigen::Ref<const prt::ShLighting>& lighting
 
 Eigen::Vector3d local_view(const meshes::Mesh& mesh, std::size_t p, const Eigen::Vector3d& eye) {
   const Eigen::Vector3d v = (eye - mesh.positions[p].cast<double>()).normalized();
-  return {mesh.tangents[p].cast<double>().dot(v), mesh.bitangents[p].cast<double>().dot(v),
-          mesh.normals[p].cast<double>().dot(v)};
+  return prt::clamp_to_horizon(
+      Eigen::Vector3d(mesh.tangents[p].cast<double>().dot(v),
+                      mesh.bitangents[p].cast<double>().dot(v), mesh.normals[p].cast<double>().dot(v)));
 }
 
 void shade_vertices(const cpca::CompressedSet& set, const ConstantLayout& layout,
@@ -108,10 +110,6 @@ void shade_vertices(const cpca::CompressedSet& set, const ConstantLayout& layout
         Eigen::VectorXf s(layout.terms * 3);
         for (std::size_t p = range.begin(); p < range.end(); ++p) {
           const Eigen::Vector3d local = local_view(mesh, p, eye);
-          if (layout.glossy && local.z() <= 0.0) {
-            radiance[p] = Rgb::Zero();  // below the local horizon (render/shading.h)
-            continue;
-          }
           basis_at(layout.order, layout.glossy, local, y.data());
           const float* k = constants + std::size_t(set.cluster_of[p]) * layout.floats_stride();
           // (terms * 3) x rows, row-major: one row per (term, colour).
@@ -139,10 +137,6 @@ std::vector<Rgb> reference_vertex_radiance(const cpca::CompressedSet& set, const
   for (std::size_t p = 0; p < mesh.vertex_count(); ++p) {
     cpca::reconstruct_vertex(set, p, x.data());
     const Eigen::Vector3d local = local_view(mesh, p, eye);
-    if (glossy && local.z() <= 0.0) {
-      out[p] = Rgb::Zero();
-      continue;
-    }
     if (glossy)
       prt::sh_eval(set.order, local, y.data());
     else
@@ -205,10 +199,6 @@ void shade_exit_vectors(const std::vector<float>& exit, int order, bool glossy,
                       Eigen::VectorXf y(rows);
                       for (std::size_t p = range.begin(); p < range.end(); ++p) {
                         const Eigen::Vector3d local = local_view(mesh, p, eye);
-                        if (glossy && local.z() <= 0.0) {
-                          radiance[p] = Rgb::Zero();
-                          continue;
-                        }
                         basis_at(order, glossy, local, y.data());
                         radiance[p] =
                             Eigen::Map<const RowMatrixXf>(exit.data() + p * 3 * rows, 3, rows) * y;

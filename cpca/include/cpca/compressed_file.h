@@ -16,7 +16,9 @@
 
 namespace cpca {
 
-inline constexpr std::uint32_t kCompressedFileVersion = 1;
+// Version 2: compressed from version-2 transfer files (prt/transfer_file.h), whose glossy
+// view side is fitted without the horizon step; version 1 files are refused, not re-read.
+inline constexpr std::uint32_t kCompressedFileVersion = 2;
 // Long enough for any PATH_MAX path on Linux; a bound so that a damaged length cannot make
 // the reader allocate gigabytes.
 inline constexpr std::size_t kMaxMeshPathBytes = 4096;

@@ -59,6 +59,8 @@ struct BakeOptions {
   int bounces = 1;
   std::uint64_t seed = 1;
   Material material;
+  // Glossy: how B's view side represents exit radiance (prt/view_fit.h); renderable fits only.
+  ViewFit view_fit = kDefaultViewFit;
   double ray_offset = 1e-4;  // times the bounding-box diagonal; origins step a tenth of it
   // Glossy only: use this n x n matrix for every channel instead of the material's BRDF
   // matrix (a measured BRDF projected elsewhere; tests pass the identity to read T_p).

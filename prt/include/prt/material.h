@@ -6,15 +6,25 @@
 //  - Phong:         f = rho_d / pi + rho_s (e + 2) / (2 pi) max(0, r.v)^e, r = 2 (s.z) z - s
 //                   (the energy-normalised "modified Phong" of Lafortune & Willems 1994)
 //  - Cook-Torrance: f = rho_d / pi + rho_s D(h) G(v, s) F(v.h) / (4 v.z s.z), h = (v+s)/|v+s|
-//                   D Beckmann with roughness m, G the original Cook-Torrance masking term
-//                   min(1, 2 h.z v.z / v.h, 2 h.z s.z / v.h), F Fresnel-Schlick with f0.
+//                   D Beckmann with roughness m, F Fresnel-Schlick with f0, and G either
+//                   - smith (the default): Smith's height-correlated masking-shadowing for
+//                     Beckmann, 1 / (1 + Lambda(v) + Lambda(s)), Lambda(w) = (erf(a) - 1) / 2
+//                     + exp(-a^2) / (2 a sqrt(pi)), a = w.z / (m sqrt(1 - w.z^2)) (Heitz,
+//                     "Understanding the masking-shadowing function", JCGT 2014), or
+//                   - v-groove: the original Cook-Torrance term
+//                     min(1, 2 h.z v.z / v.h, 2 h.z s.z / v.h) (the thesis's model).
+//                   Smith is the default because it follows from the microsurface Beckmann
+//                   describes and is what path tracers use, so independent references agree.
 // rho_d is RGB; when its three channels are equal the material is grey and transfer needs one
 // channel, otherwise three (rho_s, e, m and f0 are the same for all channels).
 //
-// BRDF matrix (thesis ch. 3.1.1), for one channel:
-//     B_ij = int_{v.z>0} int_{s.z>0} y_i(v) f_r(v, s) s.z y_j(s) ds dv
-// so that exit radiance toward local v is y(v)^T B l_local for local incident lighting l_local.
+// BRDF matrix (thesis ch. 3.1.1), for one channel: with g_j(v) = int_{s.z>0} f_r(v, s) s.z
+// y_j(s) ds, the exit radiance of local lighting y_j, B's column j holds the view-side fit of
+// g_j (prt/view_fit.h), so that exit radiance toward local v (v.z >= 0) is y(v)^T B l_local for
+// local incident lighting l_local. The thesis's fit is B_ij = int_{v.z>0} y_i g_j.
 #pragma once
+
+#include "prt/view_fit.h"
 
 #include <Eigen/Core>
 
@@ -23,6 +33,7 @@
 namespace prt {
 
 enum class MaterialKind { kLambert, kPhong, kCookTorrance };
+enum class Masking { kSmith, kVGroove };  // Cook-Torrance's G
 
 struct Material {
   MaterialKind kind = MaterialKind::kPhong;
@@ -31,6 +42,7 @@ struct Material {
   float exponent = 32.f;   // Phong e in [0, 10000]
   float roughness = 0.3f;  // Cook-Torrance Beckmann m in (0, 1]
   float f0 = 0.04f;        // Fresnel reflectance at normal incidence, in [0, 1]
+  Masking masking = Masking::kSmith;
 
   bool grey() const { return albedo.x() == albedo.y() && albedo.y() == albedo.z(); }
   int channels() const { return grey() ? 1 : 3; }
@@ -42,6 +54,8 @@ struct Material {
 const char* material_name(MaterialKind kind);  // "lambert", "phong", "cook-torrance"
 // Parses a name as printed by material_name; throws std::invalid_argument listing the names.
 MaterialKind parse_material(const std::string& name);
+const char* masking_name(Masking masking);  // "smith", "v-groove"
+Masking parse_masking(const std::string& name);
 
 // f_r for one channel (0..2; a grey material ignores it). Local frame, unit vectors.
 double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,
@@ -65,10 +79,19 @@ BrdfQuadrature resolve_brdf_quadrature(const Material& material, int order,
 // by f_r evaluations (view nodes x light nodes) and runs in parallel; a glossy Phong lobe at
 // order 6 takes well under a second.
 Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
-                            const BrdfQuadrature& quadrature = {});
+                            const BrdfQuadrature& quadrature = {},
+                            ViewFit fit = kDefaultViewFit, double view_lambda = kViewFitLambda);
 
-// Lambert's B in closed form: (rho / pi) a b^T with a_l = int y_l^0 over the hemisphere and
-// b_l the clamped-cosine zonal coefficients, non-zero only on m = 0 entries (rank one).
-Eigen::MatrixXd lambert_brdf_matrix(double albedo, int order);
+// Directional albedo int_{s.z>0} f_r(v, s) s.z ds of one channel toward the local view v
+// (v.z > 0), by a dense product quadrature independent of brdf_matrix's grids (the oracle of
+// the white-sky tests and benchmarks).
+double directional_albedo(const Material& material, int channel, const Eigen::Vector3d& v);
+
+// Lambert's B in closed form, rank one on the m = 0 entries. Exit radiance is the constant
+// (rho / pi) b . l (b_l the clamped-cosine zonal coefficients), which the least-squares and
+// even fits represent exactly: sqrt(4 pi) (rho / pi) e_0 b^T. The thesis's fit gives
+// (rho / pi) a b^T with a_l = int y_l^0 over the hemisphere; HSH's is that of hemisphere
+// with a_l = sqrt(2 pi) on l = 0 only.
+Eigen::MatrixXd lambert_brdf_matrix(double albedo, int order, ViewFit fit = kDefaultViewFit);
 
 }  // namespace prt

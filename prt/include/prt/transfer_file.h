@@ -17,7 +17,9 @@
 
 namespace prt {
 
-inline constexpr std::uint32_t kTransferFileVersion = 1;
+// Version 2 records the view fit and Cook-Torrance's masking (prt/view_fit.h, material.h);
+// version 1 held the thesis's hemisphere projection and is refused with "bake it again".
+inline constexpr std::uint32_t kTransferFileVersion = 2;
 
 class TransferFileError : public std::runtime_error {
  public:

@@ -8,9 +8,11 @@
 // and a vertex p of cluster k with weights w_pj has the exit-radiance SH vector
 //     e_p = a_k + sum_j w_pj b_kj,   radiance toward world v = y(F_p^T v) . e_p[:, c]
 // (glossy), or e_p itself (diffuse, view independent; there y is the constant 1).
-// Glossy radiance is zero where the view is at or below the local horizon (F_p^T v).z <= 0:
-// nothing leaves a surface backwards, and there the order-n truncation of the lobe rings
-// negative (every path and every reference here applies the same cut).
+// Glossy radiance toward a view below the local horizon, (F_p^T v).z < 0, is that toward the
+// most grazing view above it (prt::clamp_to_horizon): at a silhouette the interpolated
+// surface still faces the eye while the vertex's own plane does not. The view fit is defined
+// up to the horizon; below it is the fit's free extension (prt/view_fit.h). Every path and
+// every reference here clamps the same way.
 //
 // Constant layout, shared with the GLSL generator (render/shader_source.h) and matching
 // cpca::registers_per_cluster: per cluster, terms t = 0 (the mean) .. N, then colour c,
@@ -69,7 +71,8 @@ class ShadingConstants {
   std::vector<Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> packed_;
 };
 
-// Local-frame unit view direction at vertex p: F_p^T normalize(eye - position).
+// Local-frame unit view direction at vertex p: F_p^T normalize(eye - position), clamped to
+// the upper hemisphere (prt::clamp_to_horizon).
 Eigen::Vector3d local_view(const meshes::Mesh& mesh, std::size_t p, const Eigen::Vector3d& eye);
 
 // Fast CPU shading (the `cpu` render mode): per-vertex radiance from the constants of
