@@ -304,7 +304,7 @@ TEST(TransferFile, DocumentedOffsetsAndIndexFormula) {
   const std::string bytes = slurp(p);
 
   EXPECT_EQ(bytes.substr(0, 8), "PRTRXFER");
-  EXPECT_EQ(peek<std::uint32_t>(bytes, kOffVersion), 1u);
+  EXPECT_EQ(peek<std::uint32_t>(bytes, kOffVersion), 2u);
   EXPECT_EQ(peek<std::uint32_t>(bytes, kOffHeaderBytes), 128u);
   EXPECT_EQ(peek<std::uint32_t>(bytes, kOffKind), 1u);
   EXPECT_EQ(peek<std::uint32_t>(bytes, kOffOrder), 3u);
@@ -326,8 +326,9 @@ TEST(TransferFile, DocumentedOffsetsAndIndexFormula) {
             common::fnv1a(bytes.data() + kPayloadOffset, bytes.size() - kPayloadOffset));
   EXPECT_EQ(peek<std::uint64_t>(bytes, kOffHeaderChecksum),
             common::fnv1a(bytes.data(), kOffHeaderChecksum));
-  for (std::size_t i = 92; i < 96; ++i) EXPECT_EQ(bytes[i], 0) << "reserved byte " << i;
-  for (std::size_t i = 112; i < 120; ++i) EXPECT_EQ(bytes[i], 0) << "reserved byte " << i;
+  EXPECT_EQ(peek<std::uint32_t>(bytes, 92), std::uint32_t(set.view_fit));           // view_fit
+  EXPECT_EQ(peek<std::uint32_t>(bytes, 112), std::uint32_t(set.material.masking));  // masking
+  for (std::size_t i = 116; i < 120; ++i) EXPECT_EQ(bytes[i], 0) << "reserved byte " << i;
 
   // index ((p * C + c) * rows + i) * cols + j, rows = n = order^2, cols = n for glossy.
   const std::size_t C = 3, n = 9, cols = n;
@@ -379,10 +380,23 @@ TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
     check("wrong magic", p, "not a prtr transfer file");
   }
   {
-    const fs::path p = fresh("version2");
-    patch<std::uint32_t>(p, kOffVersion, 2);
+    const fs::path p = fresh("version3");
+    patch<std::uint32_t>(p, kOffVersion, 3);
     reseal_header(p);
-    check("version 2", p, "written by a newer prtr version (file format version 2");
+    check("version 3", p, "written by a newer prtr version (file format version 3");
+  }
+  {
+    // Version 1 held the thesis's hemisphere projection: refused, never re-read as version 2.
+    const fs::path p = fresh("version1");
+    patch<std::uint32_t>(p, kOffVersion, 1);
+    reseal_header(p);
+    check("version 1", p, "written by an older prtr version (file format version 1");
+  }
+  {
+    const fs::path p = fresh("view_fit");
+    patch<std::uint32_t>(p, 92, 7);
+    reseal_header(p);
+    check("view fit", p, "view fit 7 out of range");
   }
   {
     const fs::path p = fresh("version0");
@@ -524,7 +538,7 @@ TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
     ASSERT_NE(colon, std::string::npos) << name << ": " << msg;
     EXPECT_TRUE(problems.insert(msg.substr(colon + 2)).second) << name << " repeats: " << msg;
   }
-  EXPECT_EQ(messages.size(), 25u);
+  EXPECT_EQ(messages.size(), 27u);
 }
 
 // --- Writing ---------------------------------------------------------------------------------
