@@ -88,6 +88,21 @@ run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --order 11; expect_code 2; check "bake
 run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --material lambert --exponent 8
 expect_code 2 && [[ $err == *--exponent* ]]; check "bake: --exponent with lambert is a usage error" $?
 run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --albedo 0.5,0.5; expect_code 2; check "bake: --albedo with two values is a usage error" $?
+run info "$tmp/cube.prtx"
+expect_code 0 && [[ $out =~ view\ fit\ +least-squares ]]; check "info: the default view fit is least-squares" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --view-fit hsh; expect_code 2; check "bake: --view-fit hsh (benchmarks only) is a usage error" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --kind diffuse --view-fit even
+expect_code 2 && [[ $err == *--view-fit* ]]; check "bake: --view-fit with --kind diffuse is a usage error" $?
+run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --material phong --masking v-groove
+expect_code 2 && [[ $err == *--masking* ]]; check "bake: --masking with phong is a usage error" $?
+run bake "$tmp/cube.obj" -o "$tmp/ct.prtx" --order 2 --samples 16 --bounces 0 --material cook-torrance --masking v-groove --view-fit hemisphere --quiet
+run info "$tmp/ct.prtx"
+expect_code 0 && [[ $out == *"masking v-groove"* ]] && [[ $out =~ view\ fit\ +hemisphere ]]; check "info: masking and view fit as baked" $?
+# A version-1 file (the thesis's projection) is refused, not re-read: patch the version and
+# reseal nothing (the version check comes first).
+cp "$tmp/ct.prtx" "$tmp/v1.prtx" && printf '\x01' | dd of="$tmp/v1.prtx" bs=1 seek=8 conv=notrunc status=none
+run info "$tmp/v1.prtx"
+expect_code 1 && [[ $err == *v1.prtx* ]] && [[ $err == *"older prtr version"* ]]; check "info: a version 1 .prtx is refused naming it" $?
 run bake "$tmp/cube.obj" -o "$tmp/x.prtx" --albedo 0.9 --specular 0.5
 expect_code 2 && [[ $err == *--specular* || $err == *--albedo* ]]; check "bake: albedo + specular > 1 is a usage error" $?
 run bake "$tmp/missing.obj" -o "$tmp/x.prtx"; expect_code 1 && [[ $err == *missing.obj* ]]; check "bake: missing mesh exits 1 naming it" $?
