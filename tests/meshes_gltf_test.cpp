@@ -263,6 +263,29 @@ TEST(GltfErrors, UrisOutsideTheFolderAreRefused) {
   expect_load_error(write_file("textured_escape.gltf", as_gltf(textured)), "image 0 refers to");
 }
 
+TEST(GltfErrors, AccessorsMustHaveTheTypeOfTheirRole) {
+  // The exact 609-byte file that crashed Assimp (SIGSEGV): a LINE_LOOP whose indices name the
+  // float VEC3 position accessor.
+  const std::string crash =
+      R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+      R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":0,"mode":2}]}],)"
+      R"("buffers":[{"byteLength":72,"uri":"data:application/octet-stream;base64,)"
+      R"(AAAAAAAiYnl0ZUxlbmd0aCI6IDcyfV0sICJidWZmZXJWaWV3cwAED6AAAAAAAIA/AAACAAEAAAABAAMAAAADAAIAAQECAAMA"}],)"
+      R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,)"
+      R"("byteLength":24}],"accessors":[{"bufferView":0,"componentType":5126,"count":4,)"
+      R"("type":"VEC3","min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,)"
+      R"("count":12,"type":"SCALAR"}]})";
+  expect_load_error(write_file("line_loop_float_indices.gltf", crash),
+                    "indices accessor 0 is not SCALAR of unsigned");
+  Scene positions = two_mesh_scene();
+  positions.gltf["meshes"][1]["primitives"][0]["attributes"]["POSITION"] = 2;  // the indices
+  expect_load_error(write_file("scalar_positions.gltf", as_gltf(positions)),
+                    "POSITION accessor");
+  Scene mode = two_mesh_scene();
+  mode.gltf["meshes"][0]["primitives"][0]["mode"] = 9;
+  expect_load_error(write_file("mode9.gltf", as_gltf(mode)), "mode 9");
+}
+
 TEST(GltfErrors, HostileStructureIsRefusedBeforeAssimp) {
   std::string deep = R"({"asset":{"version":"2.0"},"x":)";
   deep += std::string(100000, '[') + std::string(100000, ']') + "}";

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <optional>
 #include <string_view>
@@ -332,8 +333,40 @@ void check_meshes(const json& root) {
           refuse(at + "'s attribute " + name + " names no accessor; the file is damaged");
         }
       }
-      if (primitive.contains("indices"))
-        index_into(primitive, "indices", accessors, at, "accessor");
+      // Each accessor must have the type its role reads: Assimp trusts the roles, so float
+      // positions named as indices were read as indices (and crashed the line-loop path).
+      const json& accessor_list = array_at(root, "accessors");
+      const auto expect_role = [&](std::uint64_t a, const char* role, const char* type,
+                                   std::initializer_list<std::uint64_t> component_types,
+                                   const char* wanted) {
+        const json& accessor = accessor_list[a];
+        const auto t = accessor.find("type");
+        const auto c = accessor.find("componentType");
+        const bool type_ok = t != accessor.end() && t->is_string() && t->get<std::string>() == type;
+        bool component_ok = false;
+        if (c != accessor.end() && c->is_number_unsigned())
+          for (std::uint64_t allowed : component_types) component_ok |= c->get<std::uint64_t>() == allowed;
+        if (!type_ok || !component_ok) {
+          refuse(at + "'s " + role + " accessor " + std::to_string(a) + " is not " + wanted +
+                 "; the file is damaged");
+        }
+      };
+      for (const char* name : {"POSITION", "NORMAL"}) {
+        const auto value = attributes->find(name);
+        if (value != attributes->end())
+          expect_role(value->get<std::uint64_t>(), name, "VEC3", {5126}, "VEC3 of floats");
+      }
+      if (primitive.contains("indices")) {
+        const std::uint64_t a = index_into(primitive, "indices", accessors, at, "accessor");
+        expect_role(a, "indices", "SCALAR", {5121, 5123, 5125},
+                    "SCALAR of unsigned bytes, shorts or ints");
+      }
+      if (const auto mode = primitive.find("mode"); mode != primitive.end()) {
+        if (!mode->is_number_unsigned() || mode->get<std::uint64_t>() > 6) {
+          refuse(at + " has mode " + mode->dump() +
+                 ", not one of glTF's primitive modes 0 to 6; the file is damaged");
+        }
+      }
     }
   }
 }
