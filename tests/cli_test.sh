@@ -126,6 +126,27 @@ errors=$(jget - /average_se /relative_error /clusters /method <<<"$out" | tr '\n
 run info "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --transfer "$tmp/cube.prtx" --verify
 expect_code 0 && [[ $out == *current* && $out != *STALE* ]]; check "info: .prtc current against its mesh and bake" $?
 run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: .prtc stale against another mesh" $?
+
+# An output never destroys an input, another output or a special file (common/output_path.h):
+# usage errors naming the flag, before any work, and the input is left as it was.
+before=$(cksum <"$tmp/cube.obj")
+run bake "$tmp/cube.obj" -o "$tmp/cube.obj" --order 2 --samples 16 -q
+expect_code 2 && [[ $err == *"-o"*"is the input MESH"* ]] && [[ $(cksum <"$tmp/cube.obj") == "$before" ]]
+check "bake -o MESH is refused and the mesh is kept" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/cube.prtx" --clusters 2 --pcs 2 -q
+expect_code 2 && [[ $err == *"is the input TRANSFER"* ]] && [[ $(head -c 8 "$tmp/cube.prtx") == PRTRXFER ]]
+check "compress -o TRANSFER is refused and the bake is kept" $?
+run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/cube.obj" --clusters 2 --pcs 2 -q
+expect_code 2 && [[ $err == *"is the input --mesh"* ]]; check "compress -o MESH is refused" $?
+run bake "$tmp/cube.obj" -o /dev/null --order 2 --samples 16 -q
+expect_code 2 && [[ $err == *"character device"* ]] && [[ -c /dev/null ]]; check "bake -o /dev/null is refused and /dev/null stays a device" $?
+mkfifo "$tmp/fifo" && run bake "$tmp/cube.obj" -o "$tmp/fifo" --order 2 --samples 16 -q
+expect_code 2 && [[ $err == *FIFO* ]] && [[ -p $tmp/fifo ]]; check "bake -o FIFO is refused and the FIFO stays" $?
+ln -sf "$tmp/elsewhere.prtx" "$tmp/link.prtx" && run bake "$tmp/cube.obj" -o "$tmp/link.prtx" --order 2 --samples 16 -q
+expect_code 2 && [[ $err == *"symbolic link"* ]] && [[ -L $tmp/link.prtx ]]; check "bake -o SYMLINK is refused and the link stays" $?
+run render "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --probe x.exr -o "$tmp/r.exr" --png "$tmp/r.exr"
+expect_code 2 && [[ $err == *"--png and -o both name"* ]]; check "render -o X --png X is refused" $?
+run mesh "$tmp/cube.obj" -o "$tmp/cube.obj"; expect_code 2; check "mesh -o MESH is refused" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 9
 expect_code 2 && [[ $err == *--clusters* ]]; check "compress: more clusters than vertices is a usage error" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --pcs 81

@@ -2,6 +2,7 @@
 #include "common/check.h"
 #include "common/enum_names.h"
 #include "common/hash.h"
+#include "common/output_path.h"
 
 #include "test_support.h"
 
@@ -10,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include <sys/stat.h>
 
 namespace {
 
@@ -67,6 +70,40 @@ TEST(AtomicFile, MissingDirectoryNamesTarget) {
   } catch (const common::IoError& e) {
     EXPECT_NE(std::string(e.what()).find("out.bin"), std::string::npos) << e.what();
   }
+}
+
+TEST(OutputPath, SpecialFilesAreRefusedAndKept) {
+  // A rename over a FIFO, a symbolic link or a directory would replace it; commit refuses.
+  const fs::path fifo = scratch("fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const fs::path link = scratch("link");
+  fs::create_symlink(scratch("elsewhere"), link);
+  for (const fs::path& target : {fifo, link}) {
+    common::AtomicFile file(target);
+    file.write("x", 1);
+    EXPECT_THROW(file.commit(), common::IoError) << target;
+  }
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+  EXPECT_NE(common::output_target_problem("/dev/null").find("character device"),
+            std::string::npos);
+  EXPECT_NE(common::output_target_problem(fifo.parent_path()).find("directory"),
+            std::string::npos);
+  EXPECT_EQ(common::output_target_problem(scratch("new.bin")), "");
+}
+
+TEST(OutputPath, OutputsNeverNameAnInputOrEachOther) {
+  const fs::path in = scratch("in.obj");
+  std::ofstream(in) << "v 0 0 0\n";
+  // The same file by another spelling.
+  const fs::path other = in.parent_path() / "." / in.filename();
+  EXPECT_NE(common::outputs_problem({{"-o", other}}, {{"MESH", in}}).find("is the input MESH"),
+            std::string::npos);
+  EXPECT_NE(common::outputs_problem({{"-o", scratch("a.exr")}, {"--png", scratch("a.exr")}}, {})
+                .find("both name"),
+            std::string::npos);
+  EXPECT_EQ(common::outputs_problem({{"-o", scratch("out.prtx")}, {"--png", ""}}, {{"MESH", in}}),
+            "");
 }
 
 TEST(Dcheck, ReleaseBuildsDoNotEvaluateTheCondition) {

@@ -2,6 +2,8 @@
 
 #include "subprocess.h"
 
+#include "common/output_path.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <unistd.h>
@@ -43,6 +45,7 @@ struct TemporaryFile {
 };
 
 void commit(const fs::path& temporary, const fs::path& target) {
+  common::check_output_target(target);
   std::error_code ec;
   fs::rename(temporary, target, ec);
   if (ec) throw std::runtime_error("cannot write " + target.string() + ": " + ec.message());

@@ -2,6 +2,7 @@
 // to the file block by block (prt::bake_to_file), so the payload never sits in memory whole.
 #include "bake_flags.h"
 #include "commands.h"
+#include "flag_checks.h"
 #include "json_output.h"
 #include "meshes/load.h"
 #include "mpi_world.h"
@@ -177,6 +178,7 @@ Runner add_bake_command(CLI::App& app) {
 
   return [opt] {
     Options& o = *opt;
+    check_outputs({{"-o", o.output}}, {{"MESH", o.mesh}});
     prt::BakeOptions options = resolve_bake_flags(o.flags);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     prt::BakeStats stats;

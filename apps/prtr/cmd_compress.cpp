@@ -1,6 +1,7 @@
 // prtr compress TRANSFER --mesh MESH -o FILE: clustered PCA of a bake (LBG or iterative CPCA,
 // optional geometry coherence and overdraw-aware reassignment), with a one-screen report.
 #include "commands.h"
+#include "flag_checks.h"
 #include "compress_flags.h"
 #include "json_output.h"
 #include "mpi_world.h"
@@ -197,6 +198,7 @@ Runner add_compress_command(CLI::App& app) {
 
   return [opt] {
     const Options& o = *opt;
+    check_outputs({{"-o", o.output}}, {{"TRANSFER", o.transfer}, {"--mesh", o.mesh}});
     const cpca::CompressOptions options = resolve_compress_flags(o.compress);
     check_sizes(options, o);
     if (mpi_world().size > 1) return mpi_compress(o, options);

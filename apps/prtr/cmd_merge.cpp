@@ -1,6 +1,7 @@
 // prtr merge SHARDS... -o FILE.prtx: the shards of `prtr bake --shard k/n` into the .prtx
 // one process would have written, after checking they belong together.
 #include "commands.h"
+#include "flag_checks.h"
 
 #include "prt/transfer_file.h"
 #include "prt/transfer_shard.h"
@@ -24,6 +25,9 @@ Runner add_merge_command(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Transfer file to write (.prtx)")->required();
 
   return [opt] {
+    std::vector<common::NamedPath> inputs;
+    for (const std::string& shard : opt->shards) inputs.push_back({"SHARD", shard});
+    check_outputs({{"-o", opt->output}}, inputs);
     std::vector<std::filesystem::path> paths(opt->shards.begin(), opt->shards.end());
     prt::merge_shards(paths, opt->output);
     const prt::TransferSet header = prt::read_transfer_header(opt->output);

@@ -1,6 +1,7 @@
 // prtr mesh FILE: load a mesh the way every later stage will, and print what was found;
 // with -o, write it (after --subdivide N rounds of Loop subdivision) as binary PLY.
 #include "commands.h"
+#include "flag_checks.h"
 
 #include "meshes/load.h"
 #include "meshes/subdivide.h"
@@ -64,6 +65,7 @@ Runner add_mesh_command(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Write the loaded (and subdivided) mesh here (.ply)");
 
   return [opt] {
+    check_outputs({{"-o", opt->output}}, {{"MESH", opt->path}});
     if (opt->subdivide > 0 && opt->output.empty()) {
       throw UsageError("--subdivide needs -o OUT.ply to write the refined mesh to");
     }

@@ -4,10 +4,15 @@
 // checked for finiteness where they are parsed: exit 2 naming the flag.
 #pragma once
 
+#include "commands.h"
+
+#include "common/output_path.h"
+
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace prtr_app {
 
@@ -20,6 +25,14 @@ inline CLI::Validator finite_number() {
         return {};
       },
       "FINITE");
+}
+
+// Refuses, before any work, an output that would destroy an input, replace another output or
+// replace a special file (common/output_path.h): a usage error naming the flag.
+inline void check_outputs(const std::vector<common::NamedPath>& outputs,
+                          const std::vector<common::NamedPath>& inputs) {
+  if (const std::string problem = common::outputs_problem(outputs, inputs); !problem.empty())
+    throw UsageError(problem);
 }
 
 }  // namespace prtr_app

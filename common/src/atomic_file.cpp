@@ -1,5 +1,7 @@
 #include "common/atomic_file.h"
 
+#include "common/output_path.h"
+
 #include <fcntl.h>
 #include <signal.h>
 #include <unistd.h>
@@ -141,6 +143,7 @@ void AtomicFile::commit() {
     throw IoError(target_.string() + ": close failed (" + errno_text() + ")");
   }
   fd_ = -1;
+  check_output_target(target_);
   if (::rename(temp_.c_str(), target_.c_str()) != 0) {
     throw IoError(target_.string() + ": cannot replace the file (" + errno_text() + ")");
   }

@@ -12,6 +12,7 @@
 #include "common/binary_file.h"
 #include "common/hash.h"
 #include "common/mapped_file.h"
+#include "common/output_path.h"
 
 #include <algorithm>
 #include <array>
@@ -590,6 +591,7 @@ void commit_transfer_slices(const fs::path& path, const TransferSet& shape) {
     throw;
   }
   ::close(fd);
+  common::check_output_target(path);
   if (::rename(partial.c_str(), path.c_str()) != 0) {
     throw common::IoError(path.string() + ": cannot replace the file (" + std::strerror(errno) +
                           ")");

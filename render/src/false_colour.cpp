@@ -4,6 +4,9 @@
 
 #include "render/image.h"
 
+#include "common/atomic_file.h"
+#include "common/output_path.h"
+
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -283,6 +286,8 @@ void write_picture_png(const fs::path& path, const Picture& picture) {
   if (!out->open(temp.string(), spec)) fail(out->geterror());
   if (!out->write_image(OIIO::TypeDesc::UINT8, picture.rgb.data())) fail(out->geterror());
   if (!out->close()) fail(out->geterror());
+  if (const std::string problem = common::output_target_problem(path); !problem.empty())
+    fail(problem + "; write to another path");
   std::error_code ec;
   fs::rename(temp, path, ec);
   if (ec) fail("rename failed: " + ec.message());

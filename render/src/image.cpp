@@ -1,6 +1,7 @@
 #include "render/image.h"
 
 #include "common/atomic_file.h"
+#include "common/output_path.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -37,6 +38,8 @@ void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const v
   if (!out->open(temp.string(), spec)) fail(out->geterror());
   if (!out->write_image(spec.format, data)) fail(out->geterror());
   if (!out->close()) fail(out->geterror());
+  if (const std::string problem = common::output_target_problem(path); !problem.empty())
+    fail(problem + "; write to another path");
   std::error_code ec;
   fs::rename(temp, path, ec);
   if (ec) fail("rename failed: " + ec.message());
