@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -747,6 +749,20 @@ TEST(Load, QuadIsFanTriangulatedAndUppercaseExtensionWorks) {
     EXPECT_NEAR(total_area(m), 1.25, 1e-6);
     for (const Vec3& n : m.normals) EXPECT_LT((n - Vec3(0, 1, 0)).norm(), 1e-6f);
   }
+}
+
+TEST(Load, ObjMaterialLibrariesAreNeverOpened) {
+  // Materials are not used; an mtllib naming a FIFO used to block forever and one naming
+  // ../../dev/zero to read until memory ran out.
+  const fs::path obj = write_file("mtllib.obj",
+                                  "mtllib mtllib.fifo\n  mtllib ../../../../../../../../dev/zero\n"
+                                  "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const fs::path fifo = obj.parent_path() / "mtllib.fifo";
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const Mesh m = meshes::load_mesh(obj);
+  EXPECT_EQ(m.vertex_count(), 3u);
+  EXPECT_EQ(m.triangle_count(), 1u);
 }
 
 TEST(Load, KeepsNonManifoldFaces) {

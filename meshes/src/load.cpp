@@ -368,11 +368,16 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
     return omio::IOManager().read(in, ".stl", importer, opt);
   }
   // OBJ: OpenMesh asserts on face corners without a vertex number, so they never reach it.
-  if (const std::string problem = detail::check_obj_faces(read_all(path)); !problem.empty()) {
+  std::string text = read_all(path);
+  if (const std::string problem = detail::check_obj_faces(text); !problem.empty()) {
     throw fail("could not parse this file as OBJ: " + problem + "; fix the line");
   }
-  // OpenMesh picks the reader by the extension (case-insensitively).
-  return omio::IOManager().read(path.string(), importer, opt);
+  // Materials are not used, and OpenMesh opens an 'mtllib' by whatever name it gives: a
+  // FIFO blocked forever, ../../dev/zero read until memory ran out. So the reader gets the
+  // file's text from memory with every mtllib line blanked, and opens nothing itself.
+  detail::blank_obj_material_libraries(text);
+  std::istringstream in(text);
+  return omio::IOManager().read(in, ".obj", importer, opt);
 }
 
 // File-system problems first, each with its own fix; returns the lower-case format.

@@ -604,4 +604,18 @@ std::string check_obj_faces(std::string_view bytes) {
   return {};
 }
 
+void blank_obj_material_libraries(std::string& text) {
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find_first_of("\r\n", start);
+    if (end == std::string::npos) end = text.size();
+    std::size_t first = text.find_first_not_of(" \t", start);
+    if (first < end && text.compare(first, 6, "mtllib") == 0 &&
+        (first + 6 == end || text[first + 6] == ' ' || text[first + 6] == '\t')) {
+      for (std::size_t i = first; i < end; ++i) text[i] = ' ';
+    }
+    start = end + 1;
+  }
+}
+
 }  // namespace meshes::detail

@@ -35,4 +35,8 @@ std::string read_ply(std::string_view bytes, RawPolygons& out);
 // each corner v, v/vt, v//vn or v/vt/vn with v a non-zero integer that fits in an int.
 std::string check_obj_faces(std::string_view bytes);
 
+// Blanks (with spaces, keeping line numbers and offsets) every 'mtllib' statement of an OBJ
+// text, so that a reader given the text opens no material library.
+void blank_obj_material_libraries(std::string& text);
+
 }  // namespace meshes::detail
