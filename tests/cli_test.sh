@@ -313,6 +313,12 @@ if [[ -f $forest ]]; then
   run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*summary* && $out == *"compress    compressed"* ]]; check "relight: a .summary of raw control and non-UTF-8 bytes is reported and rebuilt ($err)" $?
   v=$(jget "${summaries[0]}" /average_se) && awk -v v="$v" 'BEGIN { exit !(v > 0) }'; check "relight: the rebuilt .summary is JSON again ($v)" $?
   run "${rl[@]}"; expect_code 0 && [[ $out == *"compress    cached"* && $err != *unusable* ]]; check "relight: the rebuilt .summary is used" $?
+  # A bake of other settings copied over the entry's name (the name is only a hash) is
+  # reported and rebaked, not used.
+  "$prtr" bake "$tmp/cube.obj" -o "$tmp/other16.prtx" --order 2 --samples 16 --bounces 0 -q >/dev/null
+  bakes=("$tmp"/rl_cache/bake-*.prtx)
+  cp "$tmp/other16.prtx" "${bakes[0]}"
+  run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*"16 samples"* && $out == *"bake        baked"* ]]; check "relight: a cached bake whose header differs from its key is rebaked ($err)" $?
   for entry in "$tmp"/rl_cache/bake-*.prtx; do flip "$entry" 200; done
   run "${rl[@]}"; expect_code 0 && [[ $err == *unusable*payload* && $out == *"bake        baked"* ]]; check "relight: a damaged .prtx payload is rebuilt although its .prtc exists ($err)" $?
   for entry in "$tmp"/rl_cache/bake-*.prtx; do flip "$entry" 200; done

@@ -167,6 +167,24 @@ void discard(const fs::path& entry, const std::exception& why) {
   fs::remove(entry, ec);
 }
 
+// The first setting a cached bake's header disagrees with, or "".
+std::string header_mismatch(const prt::TransferSet& t, const prt::BakeOptions& o) {
+  const prt::Material& a = t.material;
+  const prt::Material& b = o.material;
+  if (t.kind != o.kind) return std::string("kind ") + prt::transfer_kind_name(t.kind);
+  if (t.order != o.order) return "order " + std::to_string(t.order);
+  if (t.samples != o.samples) return std::to_string(t.samples) + " samples";
+  if (t.bounces != o.bounces) return std::to_string(t.bounces) + " bounces";
+  if (t.seed != o.seed) return "seed " + std::to_string(t.seed);
+  if (t.kind == prt::TransferKind::kGlossy && t.view_fit != o.view_fit)
+    return std::string("view fit ") + prt::view_fit_name(t.view_fit);
+  if (a.kind != b.kind || a.albedo != b.albedo || a.specular != b.specular ||
+      a.exponent != b.exponent || a.roughness != b.roughness || a.f0 != b.f0 ||
+      a.masking != b.masking)
+    return std::string("another material (") + prt::material_name(a.kind) + ")";
+  return {};
+}
+
 }  // namespace
 
 CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
@@ -192,6 +210,10 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
       const prt::TransferSet entry = prt::read_transfer(r.path);
       if (entry.mesh_hash != meshes::content_hash(mesh))
         throw std::runtime_error("baked from another mesh");
+      // The name is a hash of the settings, but a file copied or left over under that name
+      // must not stand in for them: its header has to say the same.
+      if (const std::string differs = header_mismatch(entry, o); !differs.empty())
+        throw std::runtime_error("its header says " + differs + ", not what this bake asks for");
       r.hit = true;
       return r;
     } catch (const std::exception& e) {
