@@ -147,6 +147,10 @@ expect_code 2 && [[ $err == *"symbolic link"* ]] && [[ -L $tmp/link.prtx ]]; che
 run render "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --probe x.exr -o "$tmp/r.exr" --png "$tmp/r.exr"
 expect_code 2 && [[ $err == *"--png and -o both name"* ]]; check "render -o X --png X is refused" $?
 run mesh "$tmp/cube.obj" -o "$tmp/cube.obj"; expect_code 2; check "mesh -o MESH is refused" $?
+for bad in nan,0,0 0,inf,0 1e300,0,0; do
+  run render "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --probe x.exr -o "$tmp/r.exr" --background "$bad"
+  expect_code 2 && [[ $err == *--background* ]]; check "render --background $bad is a usage error" $?
+done
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 9
 expect_code 2 && [[ $err == *--clusters* ]]; check "compress: more clusters than vertices is a usage error" $?
 run compress "$tmp/cube.prtx" --mesh "$tmp/cube.obj" -o "$tmp/y.prtc" --clusters 2 --pcs 81

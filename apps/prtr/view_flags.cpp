@@ -3,6 +3,7 @@
 #include "commands.h"
 #include "flag_checks.h"
 
+#include <cmath>
 #include <sstream>
 #include <vector>
 
@@ -45,6 +46,13 @@ Eigen::Vector3d parse_vector(const std::string& text, const char* flag) {
   if (values.size() != 3)
     throw UsageError(std::string(flag) + " takes 3 comma-separated numbers x,y,z, got '" + text +
                      "'");
+  // std::stod reads "nan" and "inf"; a non-finite eye, axis or colour poisons every pixel.
+  // Float range too: a colour of 1e300 is infinite once the renderer narrows it.
+  for (double v : values) {
+    if (!std::isfinite(v) || std::abs(v) > 1e30)
+      throw UsageError(std::string(flag) + ": '" + text +
+                       "' has a value that is not a finite number of at most 1e30");
+  }
   return {values[0], values[1], values[2]};
 }
 
