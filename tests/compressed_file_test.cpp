@@ -175,8 +175,9 @@ TEST(CompressedFile, RoundTripIsExact) {
     set.mesh_path = c.mesh_path;
     set.means[0] = -0.f;
     set.means.back() = std::numeric_limits<float>::denorm_min();
-    if (!set.weights.empty()) set.weights.back() = std::numeric_limits<float>::lowest();
-    if (!set.bases.empty()) set.bases[0] = std::numeric_limits<float>::max();
+    // The largest magnitudes a compressed file holds.
+    if (!set.weights.empty()) set.weights.back() = -1e12f;
+    if (!set.bases.empty()) set.bases[0] = 1e12f;
     set.cluster_of.back() = std::uint32_t(c.clusters - 1);
     const fs::path p = scratch("round_trip_" + std::to_string(seed) + ".prtc");
     SCOPED_TRACE(p.string());
@@ -390,6 +391,13 @@ TEST(CompressedFile, EachCorruptionHasItsOwnMessage) {
     check("basis -inf", p, "non-finite basis value -inf at cluster 2, component 1, entry 15");
   }
   {
+    // Finite, but it overflows single precision once lit: NaN pixels with exit 0 before.
+    const fs::path p = fresh("mean_huge");
+    patch<float>(p, means + 4 * (1 * 16 + 2), 3e38f);
+    reseal_payload(p, off);
+    check("mean 3e38", p, "huge (beyond +-1e12) mean value 3");
+  }
+  {
     const fs::path p = scratch("no_such_file.prtc");
     fs::remove(p);
     check("missing", p, "no such compressed file");
@@ -407,7 +415,7 @@ TEST(CompressedFile, EachCorruptionHasItsOwnMessage) {
     ASSERT_NE(colon, std::string::npos) << name << ": " << msg;
     EXPECT_TRUE(problems.insert(msg.substr(colon + 2)).second) << name << " repeats: " << msg;
   }
-  EXPECT_EQ(messages.size(), 33u);
+  EXPECT_EQ(messages.size(), 34u);
 }
 
 // --- Writing ---------------------------------------------------------------------------------

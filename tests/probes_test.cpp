@@ -419,6 +419,11 @@ TEST(ProbeClass, ValidatesItsInput) {
   const std::string msg = error_of([&] { Probe(4, 2, rgb, "mine"); });
   EXPECT_NE(msg.find("mine"), std::string::npos) << msg;
   EXPECT_NE(msg.find("(1, 1)"), std::string::npos) << msg;
+  // Finite but past 1e20: its SH projection overflowed single precision (NaN frames).
+  rgb[5].y() = 1e38f;
+  const std::string huge = error_of([&] { Probe(4, 2, rgb, "bright"); });
+  EXPECT_NE(huge.find("beyond the largest radiance"), std::string::npos) << huge;
+  EXPECT_NO_THROW(Probe(4, 2, std::vector<Rgb>(8, Rgb::Constant(1e6f))));  // a bright sun is fine
   const Probe p = make_constant(4, 2, Rgb::Ones());
   EXPECT_THROW(p.lookup({NAN, 0, 1}), ProbeError);
   EXPECT_THROW(Probe().lookup({0, 0, 1}), ProbeError);

@@ -157,8 +157,8 @@ TEST(TransferFile, RoundTripIsExact) {
     // Values a text or rounding path would lose.
     set.data[0] = -0.f;
     set.data[1] = std::numeric_limits<float>::denorm_min();
-    set.data[2] = std::numeric_limits<float>::max();
-    set.data.back() = std::numeric_limits<float>::lowest();
+    set.data[2] = 1e12f;  // the largest magnitude a transfer file holds
+    set.data.back() = -1e12f;
     const fs::path p = scratch("round_trip_" + std::to_string(seed) + ".prtx");
     prt::write_transfer(p, set);
     EXPECT_EQ(fs::file_size(p), kPayloadOffset + 4 * set.data.size());
@@ -520,6 +520,15 @@ TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
     check("inf", p, "non-finite value inf at vertex 3, channel 0, entry (1, 1)");
   }
   {
+    const fs::path p = fresh("huge");
+    patch<float>(p, kPayloadOffset + 4 * 7, -3e38f);
+    const std::string bytes = slurp(p);
+    patch<std::uint64_t>(p, kOffPayloadChecksum,
+                         common::fnv1a(bytes.data() + kPayloadOffset, payload_bytes));
+    reseal_header(p);
+    check("huge", p, "value beyond +-1e12 -3");
+  }
+  {
     const fs::path p = scratch("no_such_file.prtx");
     fs::remove(p);
     check("missing", p, "no such transfer file");
@@ -538,7 +547,7 @@ TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
     ASSERT_NE(colon, std::string::npos) << name << ": " << msg;
     EXPECT_TRUE(problems.insert(msg.substr(colon + 2)).second) << name << " repeats: " << msg;
   }
-  EXPECT_EQ(messages.size(), 27u);
+  EXPECT_EQ(messages.size(), 28u);
 }
 
 // --- Writing ---------------------------------------------------------------------------------

@@ -242,21 +242,28 @@ std::string value_problem(const CompressedSet& set) {
              " clusters";
     }
   }
+  // Stored values are O(1) to O(100); past kMaxValue they can only be damage, and they would
+  // overflow single precision once multiplied by the lighting (NaN pixels).
+  constexpr float kMaxValue = 1e12f;
+  const auto bad = [](float v) { return !(std::abs(v) <= kMaxValue); };
+  const auto what = [](float v) {
+    return std::string(std::isfinite(v) ? "huge (beyond +-1e12) " : "non-finite ");
+  };
   for (std::size_t i = 0; i < set.weights.size(); ++i) {
-    if (!std::isfinite(set.weights[i])) {
-      return "non-finite weight " + num(set.weights[i]) + " at vertex " + std::to_string(i / n) +
+    if (bad(set.weights[i])) {
+      return what(set.weights[i]) + "weight " + num(set.weights[i]) + " at vertex " + std::to_string(i / n) +
              ", component " + std::to_string(i % n);
     }
   }
   for (std::size_t i = 0; i < set.means.size(); ++i) {
-    if (!std::isfinite(set.means[i])) {
-      return "non-finite mean value " + num(set.means[i]) + " at cluster " + std::to_string(i / d) +
+    if (bad(set.means[i])) {
+      return what(set.means[i]) + "mean value " + num(set.means[i]) + " at cluster " + std::to_string(i / d) +
              ", entry " + std::to_string(i % d);
     }
   }
   for (std::size_t i = 0; i < set.bases.size(); ++i) {
-    if (!std::isfinite(set.bases[i])) {
-      return "non-finite basis value " + num(set.bases[i]) + " at cluster " +
+    if (bad(set.bases[i])) {
+      return what(set.bases[i]) + "basis value " + num(set.bases[i]) + " at cluster " +
              std::to_string(i / (n * d)) + ", component " + std::to_string(i / d % n) + ", entry " +
              std::to_string(i % d);
     }

@@ -77,12 +77,16 @@ Probe::Probe(int width, int height, std::vector<Rgb> rgb, std::string name)
         << height_ << " map (expected " << expected << ")";
     throw ProbeError(msg.str());
   }
+  // Past kMaxRadiance the SH projection (a sum of 4 pi worth of texels) and the shading
+  // products overflow single precision into Inf and then NaN pixels.
   for (std::size_t i = 0; i < rgb_.size(); ++i) {
-    if (!rgb_[i].allFinite()) {
+    if (!rgb_[i].allFinite() || rgb_[i].cwiseAbs().maxCoeff() > kMaxRadiance) {
       std::ostringstream msg;
       msg << describe(name_) << ": texel (" << i % std::size_t(width_) << ", "
-          << i / std::size_t(width_) << ") is not finite (" << rgb_[i].x() << ", " << rgb_[i].y()
-          << ", " << rgb_[i].z() << ")";
+          << i / std::size_t(width_) << ") is "
+          << (rgb_[i].allFinite() ? "beyond the largest radiance prtr takes, 1e20," : "not finite")
+          << " (" << rgb_[i].x() << ", " << rgb_[i].y() << ", " << rgb_[i].z()
+          << "); rescale the probe";
       throw ProbeError(msg.str());
     }
   }

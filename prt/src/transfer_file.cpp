@@ -198,6 +198,16 @@ std::size_t first_non_finite(const std::vector<float>& data) {
   return data.size();
 }
 
+// Transfer values are O(1) (radiance per unit radiance); one past kMaxTransferValue can only
+// be damage, and it would overflow single precision once multiplied by the lighting.
+constexpr float kMaxTransferValue = 1e12f;
+
+std::size_t first_out_of_range(const std::vector<float>& data) {
+  for (std::size_t i = 0; i < data.size(); ++i)
+    if (!(std::abs(data[i]) <= kMaxTransferValue)) return i;
+  return data.size();
+}
+
 // Every field but the payload: the writer must not copy a whole bake.
 TransferSet without_payload(const TransferSet& set) {
   TransferSet s;
@@ -344,9 +354,9 @@ TransferSet read(const fs::path& path, bool with_payload) {
           common::get_field<std::uint64_t>(h, kOffPayloadChecksum), kFormat);
       !problem.empty())
     throw fail(problem);
-  if (const std::size_t i = first_non_finite(set.data); i != set.data.size()) {
-    throw fail("non-finite value " + num(set.data[i]) + " at " + locate(set, i) +
-               "; the file is damaged: " + kRebake);
+  if (const std::size_t i = first_out_of_range(set.data); i != set.data.size()) {
+    throw fail((std::isfinite(set.data[i]) ? "value beyond +-1e12 " : "non-finite value ") +
+               num(set.data[i]) + " at " + locate(set, i) + "; the file is damaged: " + kRebake);
   }
   return set;
 }
@@ -417,9 +427,10 @@ std::uint64_t payload_checksum(int fd, std::uint64_t floats, const fs::path& nam
 void check_finite(const fs::path& file, const TransferSet& shape, const float* data,
                   std::size_t floats, std::uint64_t first) {
   for (std::size_t i = 0; i < floats; ++i) {
-    if (!std::isfinite(data[i])) {
-      throw std::invalid_argument(file.string() +
-                                  ": cannot write the transfer set: non-finite value " +
+    if (!(std::abs(data[i]) <= kMaxTransferValue)) {
+      throw std::invalid_argument(file.string() + ": cannot write the transfer set: " +
+                                  (std::isfinite(data[i]) ? "value beyond +-1e12 "
+                                                          : "non-finite value ") +
                                   num(data[i]) + " at " + locate(shape, first + i));
     }
   }

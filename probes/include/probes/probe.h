@@ -33,6 +33,9 @@ Eigen::Vector2d latlong_uv(const Eigen::Vector3d& direction);  // direction need
 
 class CubeMap;
 
+// The largest |radiance| a texel may hold: beyond it single-precision lighting overflows.
+inline constexpr float kMaxRadiance = 1e20f;
+
 class Probe {
  public:
   Probe() = default;
