@@ -3,7 +3,6 @@
 #include "backend_context.h"
 #include "gl_api.h"
 
-#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -79,7 +78,7 @@ std::string GlContext::description() const {
 }
 
 int GlInfo::default_register_budget() const {
-  return std::min(max_vertex_uniform_vectors, max_uniform_block_size / 16);
+  return max_uniform_block_size / 16;
 }
 
 GlInfo GlContext::info() const {

@@ -53,9 +53,12 @@ struct GlInfo {
   long long max_ssbo_size = 0;         // bytes
 
   // The vec4 registers one pass may bind when no budget is given: a pass's constants are one
-  // UBO range, which must fit both the vertex stage's uniform vectors and one uniform block.
-  // Every default budget (renderer, pass grouping, benchmark) comes from here, so a driver
-  // whose block is the smaller limit cannot make them disagree.
+  // UBO range, so one uniform block's size bounds them. GL_MAX_VERTEX_UNIFORM_VECTORS counts
+  // the default block only (uniform blocks fall under the combined limit, which adds every
+  // block's size): llvmpipe offers 4096 of each, but NVIDIA 1024 default-block vectors and a
+  // 64 KiB block, and taking the smaller held a GPU to 4 of the thesis's clusters a pass
+  // instead of 16. Every default budget (renderer, pass grouping, benchmark) comes from here,
+  // so they cannot disagree.
   int default_register_budget() const;
 };
 
