@@ -1,7 +1,7 @@
-// bundle_inputs MESH OUT_DIR [SAMPLES] [ROUNDS]: the GPU benchmark's inputs, made where it
+// bundle_inputs MESH OUT_DIR [SAMPLES] [ROUNDS] [FROM]: the GPU benchmark's inputs, made where it
 // runs (scripts/run_gpu.sh), because compressed sets of the subdivided bunnies are larger
 // than the bundle may be (the x2 .prtc alone is 32 MB of floats, which do not compress).
-// For each round count 0..ROUNDS (default 2): MESH after that many rounds of Loop
+// For each round count FROM..ROUNDS (default 0..2): MESH after that many rounds of Loop
 // subdivision, written as OUT_DIR/bunny_xN.ply, baked from that PLY as `prtr bake` would
 // (glossy order 6, SAMPLES hemisphere samples, default 64, no bounces) and compressed as
 // `prtr compress` would (256 clusters x 8 PCs, LBG + power PCA) into OUT_DIR/bunny_xN.prtc.
@@ -21,20 +21,21 @@
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: bundle_inputs MESH OUT_DIR [SAMPLES] [ROUNDS]\n");
+    std::fprintf(stderr, "usage: bundle_inputs MESH OUT_DIR [SAMPLES] [ROUNDS] [FROM]\n");
     return 2;
   }
   const std::filesystem::path mesh_path = argv[1], out = argv[2];
   const int samples = argc > 3 ? std::atoi(argv[3]) : 64;
   const int rounds = argc > 4 ? std::atoi(argv[4]) : 2;
-  if (samples < 1 || rounds < 0 || rounds > 4) {
-    std::fprintf(stderr, "bundle_inputs: SAMPLES >= 1 and ROUNDS in 0..4\n");
+  const int from = argc > 5 ? std::atoi(argv[5]) : 0;
+  if (samples < 1 || rounds < 0 || rounds > 4 || from < 0 || from > rounds) {
+    std::fprintf(stderr, "bundle_inputs: SAMPLES >= 1, ROUNDS in 0..4, FROM in 0..ROUNDS\n");
     return 2;
   }
   try {
     std::filesystem::create_directories(out);
     const meshes::Mesh source = meshes::load_mesh(mesh_path);
-    for (int n = 0; n <= rounds; ++n) {
+    for (int n = from; n <= rounds; ++n) {
       const auto t0 = std::chrono::steady_clock::now();
       const std::string name = "bunny_x" + std::to_string(n);
       const std::filesystem::path ply = out / (name + ".ply");

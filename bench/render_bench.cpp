@@ -234,7 +234,14 @@ int main(int argc, char** argv) {
           o.groups = cpca::group_clusters(
               row.strategy, {set.cluster_of, tris, set.cluster_count, row.clusters_per_pass});
         }
-        render::Renderer r(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
+        std::optional<render::Renderer> made;
+        try {
+          made.emplace(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
+        } catch (const std::invalid_argument& e) {  // this context cannot run the row
+          std::printf("%-28s (skipped: %s)\n", name.c_str(), e.what());
+          continue;
+        }
+        render::Renderer& r = *made;
         // Process CPU time over every thread (llvmpipe's included) per frame: the work, which
         // a shared machine's load inflates far less than the wall clock.
         r.render(camera, lighting, Eigen::Matrix3d::Identity());  // compiles outside the count
