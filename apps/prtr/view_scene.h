@@ -23,7 +23,7 @@ struct SceneInputs {
   const cpca::CompressedSet* set = nullptr;
   std::filesystem::path transfer;  // the cached bake, loaded on the first uncompressed frame
   std::vector<std::filesystem::path> probes;
-  ViewFlags view;  // camera, background and rotation axis (width/height come per request)
+  ViewFlags view;          // camera, background and rotation axis (width/height come per request)
   render::GlSelection gl;  // the backend the scene's context is made on
 };
 
