@@ -1,6 +1,7 @@
-// render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P] [--frames F] [--width W]
-// [--height H]: the render benchmark (docs/ARCHITECTURE.md "Rendering", Measured), every
-// configuration in one run so the ratios are fair.
+// render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] [--mesh M]
+// [--frames F] [--width W] [--height H] [--gl osmesa|egl] [--gl-device N]: the render benchmark
+// (docs/ARCHITECTURE.md "Rendering", Measured), every configuration in one run so the ratios are
+// fair.
 //
 // Bunny, 256 clusters x 8 PCs, order 6, 1280 x 948 (the thesis's setting): FPS and average
 // overdraw for multipass at the context's register budget, multipass at 3 clusters per pass
@@ -11,10 +12,10 @@
 // machine inflates the wall clock far more), and the speed targets as ratios in the run. Plain
 // main() rather than Google Benchmark: each row is a median over frames with glFinish, and lighting
 // rotates every frame so constants are recomputed inside the timing.
+#include "bench_probe.h"
 #include "cpca/compressed_file.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
-#include "probes/load.h"
 #include "prt/projection.h"
 #include "prt/transfer_file.h"
 #include "render/camera.h"
@@ -27,6 +28,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -76,12 +78,20 @@ void print_targets(const std::vector<Sample>& multipass_3, const Sample& thesis,
 int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
-                 "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P] "
-                 "[--frames F] [--width W] [--height H]\n");
+                 "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] "
+                 "[--mesh M] [--frames F] [--width W] [--height H] [--gl osmesa|egl] "
+                 "[--gl-device N]\n");
     return 2;
   }
-  std::string compressed = argv[1], transfer_path,
+  std::string compressed = argv[1], transfer_path, mesh_path,
               probe_path = "/usr/share/blender/datafiles/studiolights/world/forest.exr";
+  render::GlSelection gl;
+  try {
+    gl = render::gl_selection_from_environment();  // PRTR_GL, PRTR_GL_DEVICE; flags beat it
+  } catch (const render::GlError& e) {
+    std::fprintf(stderr, "render_bench: %s\n", e.what());
+    return 2;
+  }
   int frames = 15, width = 1280, height = 948;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
@@ -89,7 +99,24 @@ int main(int argc, char** argv) {
       transfer_path = value;
     else if (flag == "--probe")
       probe_path = value;
-    else if (flag == "--frames")
+    else if (flag == "--mesh")  // the set's mesh elsewhere (the GPU bundle carries its own)
+      mesh_path = value;
+    else if (flag == "--gl") {
+      const auto backend = render::parse_gl_backend(value);
+      if (!backend) {
+        std::fprintf(stderr, "render_bench: --gl %s: use osmesa or egl\n", value.c_str());
+        return 2;
+      }
+      gl.backend = *backend;
+    } else if (flag == "--gl-device") {
+      char* end = nullptr;
+      const long n = std::strtol(value.c_str(), &end, 10);
+      if (*end || n < 0 || n > 1000) {
+        std::fprintf(stderr, "render_bench: --gl-device %s is not a device index\n", value.c_str());
+        return 2;
+      }
+      gl.device = int(n);
+    } else if (flag == "--frames")
       frames = std::atoi(value.c_str());
     else if (flag == "--width")
       width = std::atoi(value.c_str());
@@ -102,17 +129,26 @@ int main(int argc, char** argv) {
   }
   try {
     const cpca::CompressedSet set = cpca::read_compressed(compressed);
-    const meshes::Mesh mesh = meshes::load_mesh(set.mesh_path);
+    const meshes::Mesh mesh = meshes::load_mesh(mesh_path.empty() ? set.mesh_path : mesh_path);
     std::optional<prt::TransferSet> transfer;
     if (!transfer_path.empty()) transfer = prt::read_transfer(transfer_path);
-    const probes::Probe probe = probes::load_probe(probe_path);
+    const probes::Probe probe = load_bench_probe(probe_path);
     const prt::ShLighting lighting = prt::project(probe, set.order);
     const meshes::Bounds b = meshes::bounds(mesh);
     double radius = 0;
     for (const auto& p : mesh.positions) radius = std::max(radius, double((p - b.center()).norm()));
     const render::Camera camera =
         render::frame_sphere(b.center().cast<double>(), radius, width, height);
-    render::GlContext context;
+    if (gl.backend == render::GlBackend::kEgl && gl.device >= 0 &&
+        std::size_t(gl.device) >= render::list_egl_devices().size()) {
+      std::fprintf(stderr, "render_bench: --gl-device %d: EGL lists %zu devices\n", gl.device,
+                   render::list_egl_devices().size());
+      return 2;
+    }
+    render::GlContext context(gl);
+    const render::GlInfo gl_info = context.info();
+    std::printf("render_bench: %s, %s, %s\n", context.description().c_str(),
+                gl_info.renderer.c_str(), gl_info.version.c_str());
     std::printf(
         "render_bench: %s, %zu vertices, %zu triangles, %d clusters x %d PCs, order %d, "
         "%d x %d, %d frames (median)\n",
@@ -169,6 +205,7 @@ int main(int argc, char** argv) {
     };
     // The thesis configuration is the ILS row: 3 clusters per pass grouped by ILS.
     const Row rows[] = {{"multipass, context budget", render::Mode::kMultipass, 0},
+                        {"multipass, 16 clusters/pass", render::Mode::kMultipass, 16},
                         {"multipass, 3 clusters/pass", render::Mode::kMultipass, 3},
                         {"multipass, 3/pass, ILS", render::Mode::kMultipass, 3, "ils"},
                         {"decoupled, 3 clusters/pass", render::Mode::kDecoupled, 3},
@@ -197,7 +234,14 @@ int main(int argc, char** argv) {
           o.groups = cpca::group_clusters(
               row.strategy, {set.cluster_of, tris, set.cluster_count, row.clusters_per_pass});
         }
-        render::Renderer r(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
+        std::optional<render::Renderer> made;
+        try {
+          made.emplace(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
+        } catch (const std::invalid_argument& e) {  // this context cannot run the row
+          std::printf("%-28s (skipped: %s)\n", name.c_str(), e.what());
+          continue;
+        }
+        render::Renderer& r = *made;
         // Process CPU time over every thread (llvmpipe's included) per frame: the work, which
         // a shared machine's load inflates far less than the wall clock.
         r.render(camera, lighting, Eigen::Matrix3d::Identity());  // compiles outside the count
@@ -249,6 +293,9 @@ int main(int argc, char** argv) {
             (unsigned long long)t.primitives, (unsigned long long)t.fs_invocations, worst);
       }
     }
+  } catch (const std::invalid_argument& e) {  // a flag's value the benchmark cannot use
+    std::fprintf(stderr, "render_bench: %s\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "render_bench: %s\n", e.what());
     return 1;

@@ -16,6 +16,7 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
+  libegl-dev libegl-mesa0  # render/'s EGL backend (headers; Mesa's EGL for the .egl tests)
   libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
   libassimp-dev  # glTF 2.0 (.gltf, .glb) and 3DS import, meshes/src/read_assimp.cpp

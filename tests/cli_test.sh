@@ -202,6 +202,12 @@ if [[ -f $forest ]]; then
 fi
 
 run gl-info; expect_code 0 && [[ $out == *"Core"* || $out == *"core profile"* ]]; check "gl-info: core context" $?
+run gl-info --gl egl; expect_code 0 && [[ $out == *"egl device  0"* && $out == *"backend     egl device"* ]]
+check "gl-info --gl egl: lists EGL devices and renders on one" $?
+run gl-info --gl foo; expect_code 2 && [[ $err == *"--gl"* ]]; check "--gl foo exits 2 naming the flag" $?
+run gl-info --gl egl --gl-device 99; expect_code 2 && [[ $err == *"--gl-device 99"* ]]
+check "an EGL device out of range exits 2 naming it" $?
+out=$(PRTR_GL=foo "$prtr" gl-info 2>&1); [[ $? == 2 && $out == *PRTR_GL* ]]; check "PRTR_GL=foo exits 2 naming it" $?
 
 # prtr overdraw on the 8-vertex cube with tiny settings: tables, CSV, JSON, plot, pictures,
 # the bake cache, and usage errors.

@@ -8,6 +8,7 @@
 #include "commands.h"
 #include "compress_flags.h"
 #include "flag_checks.h"
+#include "gl_flags.h"
 #include "overdraw_plot.h"
 #include "overdraw_run.h"
 #include "pipeline.h"
@@ -40,6 +41,7 @@ struct Options {
   double degrees_per_frame = 1.0;
   BakeFlags bake;
   CompressFlags compress;
+  GlFlags gl;
   bool json = false, quiet = false, recompress = false, no_modes = false;
 };
 
@@ -131,6 +133,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPerRow);
   cmd->get_option("--pcs")->check(CLI::Range(1, 64));
   add_bake_flags(cmd, o.bake);  // used only when there is no --transfer
+  add_gl_flags(cmd, o.gl);
 }
 
 OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
@@ -162,6 +165,7 @@ OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
   plan.degrees_per_frame = o.degrees_per_frame;
   plan.modes = !o.no_modes;
   plan.quiet = o.quiet;
+  plan.gl = gl_selection(o.gl);
   plan.pictures = o.out;
   return plan;
 }

@@ -10,6 +10,7 @@
 #include "contact_sheet.h"
 #include "cpca/compressed_file.h"
 #include "flag_checks.h"
+#include "gl_flags.h"
 #include "meshes/load.h"
 #include "pass_grouping.h"
 #include "pipeline.h"
@@ -69,6 +70,7 @@ struct Options {
   BakeFlags bake;
   ViewFlags view;
   CompressFlags compress;
+  GlFlags gl;
   int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0;
   double degrees = 360.0;
   bool quiet = false, no_video = false;
@@ -96,6 +98,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
   add_bake_flags(cmd, o.bake);
   add_view_flags(cmd, o.view);
+  add_gl_flags(cmd, o.gl);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--columns", o.columns, "Contact sheet columns")
       ->check(CLI::Range(1, 64))
@@ -246,6 +249,7 @@ Runner add_relight_command(CLI::App& app) {
     const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
     resolve_axis(o.view);
     resolve_background(o.view);
+    const render::GlSelection gl = gl_selection(o.gl);
     check_sizes(bake, compress);
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     if (std::size_t(compress.clusters) > mesh.vertex_count())
@@ -257,7 +261,7 @@ Runner add_relight_command(CLI::App& app) {
     const cpca::CompressedSet set =
         cpca::read_compressed(bake_and_compress(o, mesh, bake, compress));
     const prt::ShLighting lighting = prt::project(probe, set.order);
-    render::GlContext context;
+    render::GlContext context(gl);
     const auto renderer = make_renderer(o, mesh, set, probe, context);
     std::vector<render::Image> thumbnails;
     const FrameTimes times = render_frames(o, *renderer, camera, lighting, thumbnails);

@@ -3,6 +3,7 @@
 // frame times (render/renderer.h describes the modes).
 #include "commands.h"
 #include "flag_checks.h"
+#include "gl_flags.h"
 #include "json_output.h"
 #include "pass_grouping.h"
 #include "view_flags.h"
@@ -40,6 +41,7 @@ struct Options {
   std::string compressed, probe, mesh, transfer, output, png, mode = "multipass";
   std::string strategy = "order";
   ViewFlags view;
+  GlFlags gl;
   double rotate_deg = 0.0, degrees_per_frame = 1.0;
   int register_budget = 0, clusters_per_pass = 0, frames = 20, warmup = 3;
   // The written image only: timing frames stay at --width x --height.
@@ -91,6 +93,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_flag("--no-cull", o.no_cull, "Draw back faces too (open meshes)");
   cmd->add_flag("--no-reorder", o.no_reorder,
                 "Keep triangles in mesh order (no vertex-cache order)");
+  add_gl_flags(cmd, o.gl);
   cmd->add_flag("--json", o.json, "Print one JSON line of results");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors (and the --json line)");
 }
@@ -211,6 +214,7 @@ Runner add_render_command(CLI::App& app) {
                    {"--probe", o.probe},
                    {"--mesh", o.mesh},
                    {"--transfer", o.transfer}});
+    const render::GlSelection gl = gl_selection(o.gl);
     render::RendererOptions ro = renderer_options(o, cmd);
     const render::Background background = resolve_background(o.view);
     const Eigen::Vector3d axis = resolve_axis(o.view);
@@ -222,7 +226,7 @@ Runner add_render_command(CLI::App& app) {
     const Eigen::Matrix3d rotation = prt::axis_angle(axis, o.rotate_deg * std::numbers::pi / 180.0);
     const render::Camera camera = resolve_camera(o.view, mesh);
 
-    render::GlContext context;
+    render::GlContext context(gl);
     if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
       ro.groups = group_for_renderer(mesh, set, context, o.register_budget, o.clusters_per_pass,
                                      o.strategy);

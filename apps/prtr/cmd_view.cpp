@@ -7,6 +7,7 @@
 #include "cpca/compressed_file.h"
 #include "cpca/supercluster_strategy.h"
 #include "flag_checks.h"
+#include "gl_flags.h"
 #include "meshes/load.h"
 #include "pipeline.h"
 #include "probes/load.h"
@@ -32,6 +33,7 @@ struct Options {
   CompressFlags compress;
   ViewFlags view;
   ServerOptions server;
+  GlFlags gl;
   int register_budget = 0;
   bool quiet = false;
 };
@@ -55,6 +57,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   o.view.width = 960;  // the page's default size; it can ask for others
   o.view.height = 710;
   add_view_flags(cmd, o.view);
+  add_gl_flags(cmd, o.gl);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--host", o.server.host, "Address to listen on")->capture_default_str();
   cmd->add_option("--port", o.server.port, "Port to listen on (0: any free port)")
@@ -152,6 +155,7 @@ Runner add_view_command(CLI::App& app) {
     const prt::BakeOptions bake = resolve_bake_flags(o.bake);
     const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
     resolve_background(o.view);
+    const render::GlSelection gl = gl_selection(o.gl);
     int probe_index = 0;
     const std::vector<fs::path> probes = scan_probes(o.probe, probe_index);
     ServedInfo served;
@@ -164,7 +168,7 @@ Runner add_view_command(CLI::App& app) {
     const CompressCacheResult compressed =
         cached_compress(transfer.path, mesh, o.mesh, compress, cache, o.quiet);
     const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
-    ViewScene scene({&mesh, &set, transfer.path, probes, o.view});
+    ViewScene scene({&mesh, &set, transfer.path, probes, o.view, gl});
     served.limits = {int(probes.size()), set.cluster_count, true};
     // The initial state renders once here, so a flag the renderer refuses exits 2 now.
     const auto first = scene.render(served.defaults);

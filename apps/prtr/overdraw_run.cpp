@@ -536,7 +536,7 @@ OverdrawReport run_overdraw(const OverdrawPlan& plan) {
   OverdrawReport report;
   load_bake(s, report);
 
-  render::GlContext context(4, 5);
+  render::GlContext context(plan.gl, 4, 5);
   const render::GlInfo info = context.info();
   report.gl_renderer = info.renderer;
   s.context_budget = info.default_register_budget();

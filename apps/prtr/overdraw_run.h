@@ -21,6 +21,7 @@
 
 #include "cpca/compress.h"
 #include "prt/bake.h"
+#include "render/gl_context.h"
 
 #include <cstdint>
 #include <functional>
@@ -71,9 +72,10 @@ struct OverdrawPlan {
   int frames = 10, warmup = 2, width = 1280, height = 948;
   int rounds = 3;  // interleaved timing rounds over all rows
   double degrees_per_frame = 1.0, image_degrees = 37.0;
-  bool modes = true;     // single-pass / decoupled / uncompressed timings
-  bool quiet = true;     // no progress bar while baking
-  std::string pictures;  // directory for the cluster and overdraw pictures; empty: none
+  bool modes = true;       // single-pass / decoupled / uncompressed timings
+  bool quiet = true;       // no progress bar while baking
+  render::GlSelection gl;  // the backend every row renders on
+  std::string pictures;    // directory for the cluster and overdraw pictures; empty: none
   std::function<void(const std::string&)> note;  // one-line events (may be empty)
   std::function<void(const std::string&, std::uint64_t, std::uint64_t)> progress;
 };

@@ -64,7 +64,7 @@ struct ViewScene::Impl {
   void render_into(RenderedFrame& frame);
 
   SceneInputs inputs;
-  render::GlContext context;
+  render::GlContext context{inputs.gl};
   SceneInfo info;
   std::list<CachedRenderer> renderers;  // most recently used first
   std::map<int, prt::ShLighting> lighting;

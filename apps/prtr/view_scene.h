@@ -6,6 +6,7 @@
 
 #include "cpca/compressed.h"
 #include "meshes/mesh.h"
+#include "render/gl_context.h"
 #include "view_flags.h"
 #include "view_frame.h"
 #include "view_request.h"
@@ -22,7 +23,8 @@ struct SceneInputs {
   const cpca::CompressedSet* set = nullptr;
   std::filesystem::path transfer;  // the cached bake, loaded on the first uncompressed frame
   std::vector<std::filesystem::path> probes;
-  ViewFlags view;  // camera, background and rotation axis (width/height come per request)
+  ViewFlags view;          // camera, background and rotation axis (width/height come per request)
+  render::GlSelection gl;  // the backend the scene's context is made on
 };
 
 // What does not change while the server runs (the page's "about" statistics).

@@ -1,66 +1,84 @@
 #include "render/gl_context.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
-#include <GL/osmesa.h>
+#include "backend_context.h"
+#include "gl_api.h"
 
-#include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 namespace render {
 
+const char* gl_backend_name(GlBackend backend) {
+  return backend == GlBackend::kEgl ? "egl" : "osmesa";
+}
+
+std::optional<GlBackend> parse_gl_backend(std::string_view name) {
+  if (name == "osmesa") return GlBackend::kOsmesa;
+  if (name == "egl") return GlBackend::kEgl;
+  return std::nullopt;
+}
+
+GlSelection gl_selection_from_environment() {
+  GlSelection s;
+  if (const char* gl = std::getenv("PRTR_GL"); gl && *gl) {
+    const auto backend = parse_gl_backend(gl);
+    if (!backend)
+      throw GlError(std::string("PRTR_GL=") + gl + " is not a GL backend: use osmesa or egl");
+    s.backend = *backend;
+  }
+  if (const char* dev = std::getenv("PRTR_GL_DEVICE"); dev && *dev) {
+    char* end = nullptr;
+    errno = 0;
+    const long n = std::strtol(dev, &end, 10);
+    if (*end || errno || n < 0 || n > 1000)
+      throw GlError(std::string("PRTR_GL_DEVICE=") + dev + " is not an EGL device index");
+    s.device = int(n);
+  }
+  return s;
+}
+
 struct GlContext::Impl {
-  OSMesaContext context = nullptr;
-  std::vector<unsigned char> buffer;
-  int width = 0, height = 0;
+  GlBackend backend = GlBackend::kOsmesa;
+  std::unique_ptr<BackendContext> context;
 };
 
 GlContext::GlContext(int major, int minor, int width, int height)
+    : GlContext(gl_selection_from_environment(), major, minor, width, height) {}
+
+GlContext::GlContext(const GlSelection& selection, int major, int minor, int width, int height)
     : impl_(std::make_unique<Impl>()) {
-  const int attribs[] = {OSMESA_FORMAT,
-                         OSMESA_RGBA,
-                         OSMESA_DEPTH_BITS,
-                         24,
-                         OSMESA_STENCIL_BITS,
-                         0,
-                         OSMESA_ACCUM_BITS,
-                         0,
-                         OSMESA_PROFILE,
-                         OSMESA_CORE_PROFILE,
-                         OSMESA_CONTEXT_MAJOR_VERSION,
-                         major,
-                         OSMESA_CONTEXT_MINOR_VERSION,
-                         minor,
-                         0};
-  impl_->context = OSMesaCreateContextAttribs(attribs, nullptr);
-  if (!impl_->context) {
-    throw GlError("OSMesa could not create an OpenGL " + std::to_string(major) + "." +
-                  std::to_string(minor) +
-                  " core context (is Mesa's llvmpipe installed? try LIBGL_ALWAYS_SOFTWARE=1 or "
-                  "a newer libosmesa6)");
+  impl_->backend = selection.backend;
+  if (selection.backend == GlBackend::kOsmesa) {
+    impl_->context = make_osmesa_context(major, minor, width, height);
+    return;
   }
-  impl_->width = width;
-  impl_->height = height;
-  impl_->buffer.assign(std::size_t(width) * height * 4, 0);
-  make_current();
+  try {
+    impl_->context = make_egl_context(selection.device, major, minor);
+  } catch (const GlError& e) {
+    throw GlError(std::string("EGL failed: ") + e.what() +
+                  "; render on the CPU with OSMesa instead (--gl osmesa, or PRTR_GL=osmesa)");
+  }
 }
 
-GlContext::~GlContext() {
-  if (impl_ && impl_->context) OSMesaDestroyContext(impl_->context);
-}
+GlContext::~GlContext() = default;
 
 void GlContext::make_current() {
-  if (!OSMesaMakeCurrent(impl_->context, impl_->buffer.data(), GL_UNSIGNED_BYTE, impl_->width,
-                         impl_->height)) {
-    throw GlError("OSMesaMakeCurrent failed");
-  }
+  impl_->context->make_current();
+}
+
+GlBackend GlContext::backend() const {
+  return impl_->backend;
+}
+
+std::string GlContext::description() const {
+  return impl_->context->describe();
 }
 
 int GlInfo::default_register_budget() const {
-  return std::min(max_vertex_uniform_vectors, max_uniform_block_size / 16);
+  return max_uniform_block_size / 16;
 }
 
 GlInfo GlContext::info() const {

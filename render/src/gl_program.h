@@ -2,9 +2,7 @@
 // become GlError with the driver's log and the numbered source lines around the error.
 #pragma once
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 
 #include <string>
 #include <unordered_map>

@@ -227,6 +227,9 @@ std::vector<Rgb> Renderer::capture_vertex_radiance(
     const Camera& camera, const Eigen::Ref<const prt::ShLighting>& lighting,
     const Eigen::Matrix3d& rotation) {
   impl_->update(camera, lighting, rotation);
+  // The capture discards rasterisation, but a draw still needs a complete framebuffer: a
+  // surfaceless EGL context has no default one (GL_INVALID_FRAMEBUFFER_OPERATION).
+  impl_->target.bind(camera.width, camera.height);
   const GpuMesh& mesh = impl_->path->mesh();
   mesh.bind();
   const std::vector<Rgb> gpu = impl_->path->capture(camera);

@@ -1,0 +1,42 @@
+#include "gl_flags.h"
+
+#include "commands.h"
+
+namespace prtr_app {
+
+void add_gl_flags(CLI::App* cmd, GlFlags& flags) {
+  cmd->add_option("--gl", flags.backend,
+                  "OpenGL backend: osmesa (Mesa's llvmpipe on the CPU, runs anywhere) or egl "
+                  "(an EGL device: a GPU where there is one)")
+      ->envname("PRTR_GL")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            if (render::parse_gl_backend(text)) return {};
+            return "'" + text + "' is not a GL backend (--gl or PRTR_GL): use osmesa or egl";
+          },
+          "osmesa|egl"))
+      ->capture_default_str();
+  cmd->add_option("--gl-device", flags.device,
+                  "EGL device index for --gl egl (prtr gl-info lists them; default: the first "
+                  "GPU, else Mesa's software device)")
+      ->envname("PRTR_GL_DEVICE")
+      ->check(CLI::NonNegativeNumber);
+}
+
+render::GlSelection gl_selection(const GlFlags& flags) {
+  render::GlSelection s;
+  const auto backend = render::parse_gl_backend(flags.backend);
+  if (!backend) throw UsageError("--gl " + flags.backend + ": use osmesa or egl");
+  s.backend = *backend;
+  s.device = flags.device;
+  if (s.backend == render::GlBackend::kEgl && s.device >= 0) {
+    const std::size_t count = render::list_egl_devices().size();
+    if (std::size_t(s.device) >= count)
+      throw UsageError("--gl-device " + std::to_string(s.device) + ": EGL lists " +
+                       std::to_string(count) + " device" + (count == 1 ? "" : "s") +
+                       " (prtr gl-info --gl egl lists them)");
+  }
+  return s;
+}
+
+}  // namespace prtr_app
