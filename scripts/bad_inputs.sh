@@ -81,6 +81,13 @@ add escape.gltf mesh "glTF buffer URI leaving the file's folder"
 add deep.gltf mesh "glTF JSON nested 100,000 levels deep"
 printf '%s"skins":[{"joints":[0]}],"accessors":[],"bufferViews":[],"buffers":[]}' "$gltf_head" >skinned.gltf
 add skinned.gltf mesh "glTF with a skin"
+# Found by a hostile-input round: Assimp crashed (SIGSEGV) on a LINE_LOOP whose indices name
+# the float VEC3 position accessor.
+printf '%s' '{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":0,"mode":2}]}],"buffers":[{"byteLength":72,"uri":"data:application/octet-stream;base64,AAAAAAAiYnl0ZUxlbmd0aCI6IDcyfV0sICJidWZmZXJWaWV3cwAED6AAAAAAAIA/AAACAAEAAAABAAMAAAADAAIAAQECAAMA"}],"bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":24}],"accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}]}' >float_indices.gltf
+add float_indices.gltf mesh "glTF line loop whose indices are the float positions (crashed Assimp)"
+rm -f mtl.fifo && mkfifo mtl.fifo
+printf 'mtllib mtl.fifo\nmtllib ../../../../../../../../dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >mtllib.obj
+add mtllib.obj mesh "OBJ whose mtllib names a FIFO and ../../dev/zero (materials are never opened)"
 { printf 'glTF'; le VVVV 2 1000 100 0x4e4f534a; } >short.glb
 add short.glb mesh "GLB whose header claims 1000 bytes, 20 present"
 { head -c 80 /dev/zero; le V 5; head -c 100 /dev/zero; } >short.stl
@@ -113,6 +120,8 @@ if [[ -f $probe ]]; then
   add truncated.exr probe "real EXR cut to 2,000 bytes"
 fi
 add missing.exr probe "no such file"
+{ printf 'PF\n2 1\n-1.0\n'; perl -e 'print pack("f<", 1e38) x 6'; } >huge.pfm
+add huge.pfm probe "2 x 1 PFM of 1e38 (its SH projection overflows single precision)"
 
 # Transfer and compressed files: a real one, then damaged copies.
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' >tet.obj
@@ -124,6 +133,8 @@ if [[ -f good.prtx ]]; then
   cp good.prtx magic.prtx; flip magic.prtx 0; add magic.prtx info "transfer file with a damaged magic number"
   cp good.prtx payload.prtx; flip payload.prtx 140; add payload.prtx "info --verify" "transfer file with one payload byte flipped"
   head -c 200 good.prtx >cut.prtx; add cut.prtx info "transfer file cut inside its payload"
+  cp good.prtx v1.prtx; printf '\x01' | dd of=v1.prtx bs=1 seek=8 conv=notrunc status=none
+  add v1.prtx info "version-1 transfer file (the thesis's view projection)"
 fi
 if [[ -f good.prtc ]]; then
   cp good.prtc payload.prtc; flip payload.prtc $(($(stat -c %s good.prtc) - 3)); add payload.prtc "info --verify" "compressed file with one payload byte flipped"
