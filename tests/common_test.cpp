@@ -75,8 +75,10 @@ TEST(AtomicFile, MissingDirectoryNamesTarget) {
 TEST(OutputPath, SpecialFilesAreRefusedAndKept) {
   // A rename over a FIFO, a symbolic link or a directory would replace it; commit refuses.
   const fs::path fifo = scratch("fifo");
+  fs::remove(fifo);
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
   const fs::path link = scratch("link");
+  fs::remove(link);
   fs::create_symlink(scratch("elsewhere"), link);
   for (const fs::path& target : {fifo, link}) {
     common::AtomicFile file(target);
