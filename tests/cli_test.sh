@@ -39,6 +39,28 @@ run probe x.exr --order 11; expect_code 2; check "order 11 is a usage error" $?
 run probe x.exr --order 0; expect_code 2; check "order 0 is a usage error" $?
 run mesh a.obj --bogus; expect_code 2; check "unknown flag exits 2" $?
 
+# Every numeric flag of every command, read off --help: an empty value, a negative or
+# unparsable one and one past any range are usage errors that name the flag, and no message
+# holds a number longer than 15 digits (CLI11's own ranges printed DBL_MAX in full).
+numeric_flags=0
+for sub in bake compress merge mesh probe info render relight overdraw view gl-info; do
+  while read -r flag; do
+    numeric_flags=$((numeric_flags + 1))
+    for bad in "" "-1" "abc" "1e400" "99999999999999999999999"; do
+      run "$sub" "$flag" "$bad"
+      # "-1" is a valid value of flags whose range holds it (angles, exposure, weld
+      # tolerance): the flag is then accepted and only the missing arguments are reported.
+      [[ $bad == -1 && $err != *"$flag"* ]] && continue
+      shown=${err//"'$bad'"/}  # the value itself, echoed back, may be long
+      if ! { expect_code 2 && [[ $err == *"$flag"* ]] && ! [[ $shown =~ [0-9]{16} ]]; }; then
+        echo "  $sub $flag '$bad': exit $code: $err"; false
+      fi
+      check "$sub $flag '$bad' is a usage error naming the flag" $?
+    done
+  done < <("$prtr" "$sub" --help 2>/dev/null | grep -oE '^ +(-[a-z], ?)?--[a-z0-9-]+ (INT|UINT|FLOAT)' | grep -oE -- '--[a-z0-9-]+')
+done
+((numeric_flags > 40)); check "numeric flags found in --help: $numeric_flags" $?
+
 # Failures name the input.
 run mesh "$tmp/missing.obj"; expect_code 1 && [[ $err == *missing.obj* ]]; check "missing mesh exits 1 naming it" $?
 : >"$tmp/empty.obj"

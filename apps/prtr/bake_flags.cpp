@@ -1,6 +1,7 @@
 #include "bake_flags.h"
 
 #include "commands.h"
+#include "flag_checks.h"
 
 #include <sstream>
 #include <vector>
@@ -35,15 +36,17 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
       ->check(CLI::IsMember({"diffuse", "glossy"}))
       ->capture_default_str();
   cmd->add_option("--order", f.bake.order, "SH order N (N^2 coefficients)")
-      ->check(CLI::Range(1, 10))
+      ->check(integer_in(1, 10))
       ->capture_default_str();
   cmd->add_option("--samples", f.bake.samples, "Hemisphere directions per vertex")
-      ->check(CLI::Range(1, 65536))
+      ->check(integer_in(1, 65536))
       ->capture_default_str();
   cmd->add_option("--bounces", f.bake.bounces, "Interreflection passes (0: shadows only)")
-      ->check(CLI::Range(0, 16))
+      ->check(integer_in(0, 16))
       ->capture_default_str();
-  cmd->add_option("--seed", f.bake.seed, "Seed of the direction set")->capture_default_str();
+  cmd->add_option("--seed", f.bake.seed, "Seed of the direction set")
+      ->check(unsigned_integer())
+      ->capture_default_str();
   cmd->add_option("--material", f.material, "Reflectance model")
       ->check(CLI::IsMember({"lambert", "phong", "cook-torrance"}))
       ->capture_default_str();
@@ -51,12 +54,18 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
       ->capture_default_str();
   cmd->add_option("--specular", f.bake.material.specular,
                   "Specular reflectance (phong, cook-torrance)")
+      ->check(number_in(0, 1))
       ->capture_default_str();
-  cmd->add_option("--exponent", f.bake.material.exponent, "Phong exponent")->capture_default_str();
+  cmd->add_option("--exponent", f.bake.material.exponent, "Phong exponent")
+      ->check(number_in(0, 10000))
+      ->capture_default_str();
+  // (0, 1]: number_in takes the closed range; Material::validate refuses 0 by name.
   cmd->add_option("--roughness", f.bake.material.roughness, "Cook-Torrance Beckmann roughness")
+      ->check(number_in(0, 1))
       ->capture_default_str();
   cmd->add_option("--f0", f.bake.material.f0,
                   "Cook-Torrance Fresnel reflectance at normal incidence")
+      ->check(number_in(0, 1))
       ->capture_default_str();
   cmd->add_option("--masking", f.masking,
                   "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the "
@@ -70,6 +79,7 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
       ->capture_default_str();
   cmd->add_option("--ray-offset", f.bake.ray_offset,
                   "Rays start a tenth of this x the bbox diagonal into the face they leave through")
+      ->check(number_in(0, 0.01))
       ->capture_default_str();
 }
 

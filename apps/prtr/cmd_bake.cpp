@@ -169,6 +169,7 @@ Runner add_bake_command(CLI::App& app) {
          "Vertices computed and written per block (0: about 16 MiB of transfer); a bounce's "
          "cache of previous-pass rows holds " +
              std::to_string(prt::kGatherBlocks) + " blocks")
+      ->check(integer_in(0, 1LL << 40))
       ->capture_default_str();
   cmd->add_option("--shard", opt->shard,
                   "k/n: bake only shard k (0-based) of n vertex ranges into a shard file for "

@@ -194,6 +194,7 @@ Runner add_compress_command(CLI::App& app) {
   cmd->add_option("--block-vertices", opt->block_vertices,
                   "Vertices per block of the out-of-core passes (0: 64 MiB of rows; rounded "
                   "up to a multiple of 256); the result does not depend on it")
+      ->check(integer_in(0, 1LL << 40))
       ->capture_default_str();
 
   return [opt] {

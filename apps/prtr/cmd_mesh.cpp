@@ -55,13 +55,14 @@ Runner add_mesh_command(CLI::App& app) {
   cmd->add_option("--weld-tolerance", opt->weld,
                   "Weld positions closer than this fraction of the bounding-box diagonal "
                   "(negative: no welding)")
+      ->check(number_in(-1, 1))
       ->capture_default_str();
   cmd->add_option("--normals", opt->normals, "Vertex normal weighting")
       ->check(CLI::IsMember({"angle", "area"}))
       ->capture_default_str();
   cmd->add_option("--subdivide", opt->subdivide,
                   "Rounds of Loop subdivision before writing -o (each: ~4x the vertices)")
-      ->check(CLI::Range(0, 6));
+      ->check(integer_in(0, 6));
   cmd->add_option("-o,--output", opt->output, "Write the loaded (and subdivided) mesh here (.ply)");
 
   return [opt] {

@@ -97,25 +97,25 @@ void add_flags(CLI::App* cmd, Options& o) {
                   "number of vec4 registers")
       ->capture_default_str();
   cmd->add_option("--frames", o.frames, "Timed frames per row in every round")
-      ->check(CLI::Range(1, 100000))
+      ->check(integer_in(1, 100000))
       ->capture_default_str();
   cmd->add_option("--rounds", o.rounds,
                   "Timing rounds, each visiting every row in turn for --warmup + --frames "
                   "frames (FPS = median over all rounds, with the interquartile range)")
-      ->check(CLI::Range(1, 1000))
+      ->check(integer_in(1, 1000))
       ->capture_default_str();
   cmd->add_option("--warmup", o.warmup, "Untimed frames first (every round)")
-      ->check(CLI::Range(0, 100000))
+      ->check(integer_in(0, 100000))
       ->capture_default_str();
   cmd->add_option("--degrees-per-frame", o.degrees_per_frame,
                   "Environment rotation per frame about +Y while timing")
-      ->check(finite_number())
+      ->check(angle_degrees())
       ->capture_default_str();
   cmd->add_option("--width", o.width, "Image width")
-      ->check(CLI::Range(1, 16384))
+      ->check(integer_in(1, 16384))
       ->capture_default_str();
   cmd->add_option("--height", o.height, "Image height")
-      ->check(CLI::Range(1, 16384))
+      ->check(integer_in(1, 16384))
       ->capture_default_str();
   cmd->add_option("--out", o.out, "Directory for CSV, JSON, plot and pictures")
       ->capture_default_str();
@@ -131,7 +131,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   // The rows set K, the method and the overdraw reduction; the coherence rows use --alpha.
   o.compress.compress.alpha = 0.05;
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPerRow);
-  cmd->get_option("--pcs")->check(CLI::Range(1, 64));
+  cmd->get_option("--pcs")->check(integer_in(1, 64));
   add_bake_flags(cmd, o.bake);  // used only when there is no --transfer
   add_gl_flags(cmd, o.gl);
 }

@@ -1,5 +1,6 @@
 // prtr probe FILE: load an environment map, print its facts and its SH projection.
 #include "commands.h"
+#include "flag_checks.h"
 
 #include "probes/load.h"
 #include "prt/projection.h"
@@ -66,7 +67,7 @@ Runner add_probe_command(CLI::App& app) {
                   "px nx py ny pz nz, or a name with {face} in it")
       ->required();
   cmd->add_option("--order", opt->order, "SH order N (bands 0..N-1, N^2 coefficients)")
-      ->check(CLI::Range(prt::kMinOrder, prt::kMaxOrder))
+      ->check(integer_in(prt::kMinOrder, prt::kMaxOrder))
       ->capture_default_str();
   cmd->add_option("--layout", opt->layout,
                   "Map layout; auto: 2:1 lat-long, 1:1 angular, 4:3 / 3:4 cube cross, a folder "

@@ -81,10 +81,10 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
   cmd->add_option("--frames", o.frames, "Frames in the sequence")
-      ->check(CLI::Range(1, 100000))
+      ->check(integer_in(1, 100000))
       ->capture_default_str();
   cmd->add_option("--degrees", o.degrees, "Total environment rotation over the sequence")
-      ->check(finite_number())
+      ->check(angle_degrees())
       ->capture_default_str();
   cmd->add_option("--mode", o.mode, "Rendering path (render/renderer.h)")
       ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}))
@@ -93,7 +93,7 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--register-budget", o.register_budget,
                   "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
   add_bake_flags(cmd, o.bake);
@@ -101,13 +101,13 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_gl_flags(cmd, o.gl);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--columns", o.columns, "Contact sheet columns")
-      ->check(CLI::Range(1, 64))
+      ->check(integer_in(1, 64))
       ->capture_default_str();
   cmd->add_option("--thumbnail", o.thumbnail, "Contact sheet thumbnail width (pixels)")
-      ->check(CLI::Range(16, 4096))
+      ->check(integer_in(16, 4096))
       ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Video frame rate")
-      ->check(CLI::Range(1, 240))
+      ->check(integer_in(1, 240))
       ->capture_default_str();
   cmd->add_flag("--no-video", o.no_video, "Do not encode the MP4 (the GIF is always written)");
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");

@@ -58,7 +58,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--supersample", o.supersample,
                   "Anti-aliasing of the written image: render N x N samples per pixel and "
                   "box-filter (1: off)")
-      ->check(CLI::Range(1, 8))
+      ->check(integer_in(1, 8))
       ->capture_default_str();
   cmd->add_option("--mesh", o.mesh, "Mesh (default: the one the set was baked from)");
   cmd->add_option("--mode", o.mode, "Rendering path")
@@ -66,28 +66,28 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--transfer", o.transfer, "Raw transfer file (.prtx), for --mode uncompressed");
   cmd->add_option("--rotate-deg", o.rotate_deg, "Environment rotation angle (degrees)")
-      ->check(finite_number())
+      ->check(angle_degrees())
       ->capture_default_str();
   cmd->add_option("--register-budget", o.register_budget,
                   "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   cmd->add_option("--clusters-per-pass", o.clusters_per_pass,
                   "Clusters per pass (0: as many as the budget holds)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   cmd->add_option("--strategy", o.strategy,
                   "Super-cluster strategy: " + cpca::supercluster_strategy_names())
       ->capture_default_str();
   cmd->add_option("--frames", o.frames, "Timed frames (median reported)")
-      ->check(CLI::Range(1, 100000))
+      ->check(integer_in(1, 100000))
       ->capture_default_str();
   cmd->add_option("--warmup", o.warmup, "Untimed frames first")
-      ->check(CLI::Range(0, 100000))
+      ->check(integer_in(0, 100000))
       ->capture_default_str();
   cmd->add_option("--spin-deg", o.degrees_per_frame,
                   "Extra environment rotation per timed frame, so constants change every frame")
-      ->check(finite_number())
+      ->check(angle_degrees())
       ->capture_default_str();
   add_view_flags(cmd, o.view);
   cmd->add_flag("--no-cull", o.no_cull, "Draw back faces too (open meshes)");

@@ -50,7 +50,7 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--register-budget", o.register_budget,
                   "Initial vec4 registers per pass (0: what the GL context offers)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
   add_bake_flags(cmd, o.bake);
@@ -61,7 +61,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--host", o.server.host, "Address to listen on")->capture_default_str();
   cmd->add_option("--port", o.server.port, "Port to listen on (0: any free port)")
-      ->check(CLI::Range(0, 65535))
+      ->check(integer_in(0, 65535))
       ->capture_default_str();
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
 }

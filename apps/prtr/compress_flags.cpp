@@ -11,11 +11,11 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   const bool per_row = set == CompressFlagSet::kPerRow;
   if (!per_row) {
     cmd->add_option("--clusters", o.clusters, "Number of CPCA clusters K")
-        ->check(CLI::PositiveNumber)
+        ->check(integer_in(1, 65536))
         ->capture_default_str();
   }
   cmd->add_option("--pcs", o.components, "Principal components per cluster N")
-      ->check(CLI::NonNegativeNumber)
+      ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   if (!per_row) {
     cmd->add_option("--method", f.method,
@@ -28,8 +28,7 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   }
   cmd->add_option("--alpha", o.alpha,
                   "Geometry-coherence weight (thesis eq. 9-10; 0 = off, the thesis used 0.05)")
-      ->check(finite_number())
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(number_in(0.0, 1e6))
       ->capture_default_str();
   if (!per_row) {
     cmd->add_flag("--overdraw-reduction", o.overdraw_reduction,
@@ -37,39 +36,37 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   }
   cmd->add_option("--overdraw-tolerance", o.overdraw.tolerance,
                   "Overdraw reduction: largest error increase per move, in units of the Average SE")
-      ->check(finite_number())
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(number_in(0.0, 1e6))
       ->capture_default_str();
   if (set != CompressFlagSet::kCompress) return;
   cmd->add_option("--pca", f.pca, "power: power iteration (SLF paper); eigen: Eigen's solver")
       ->check(CLI::IsMember(cpca::pca_solver_names()))
       ->capture_default_str();
-  cmd->add_option("--seed", o.seed, "Seed of the hyper-box initialisation")->capture_default_str();
+  cmd->add_option("--seed", o.seed, "Seed of the hyper-box initialisation")
+      ->check(unsigned_integer())
+      ->capture_default_str();
   cmd->add_option("--threshold", o.lbg_threshold,
                   "LBG stops when the energy ratio (E_{i-1} - E_i) / E_{i-1} falls below this")
-      ->check(finite_number())
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(number_in(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--max-iterations", o.lbg_max_iterations, "LBG iteration cap")
-      ->check(CLI::Range(1, 100000))
+      ->check(integer_in(1, 100000))
       ->capture_default_str();
   f.per_pass = cmd->add_option("--clusters-per-pass", o.clusters_per_pass,
                                "patch-first / joint: clusters one render pass holds (16 at the "
                                "default budget for order 6 and 8 PCs, 3 at the thesis's)")
-                   ->check(CLI::Range(1, 1 << 20))
+                   ->check(integer_in(1, 1 << 20))
                    ->capture_default_str();
   f.lambda = cmd->add_option("--lambda", o.lambda,
                              "joint: overdraw weight, in units of the start's Average SE per "
                              "unit of average overdraw (0 = iterative CPCA)")
-                 ->check(finite_number())
-                 ->check(CLI::Range(0.0, 1e6))
+                 ->check(number_in(0.0, 1e6))
                  ->capture_default_str();
   f.cap = cmd->add_option("--overdraw-cap", o.overdraw_cap,
                           "joint: no vertex move may raise the average overdraw above this "
                           "(0 = no cap; else >= 1), so a small --lambda spends the allowance "
                           "on error")
-              ->check(finite_number())
-              ->check(CLI::Range(0.0, 1e6))
+              ->check(number_in(0.0, 1e6))
               ->capture_default_str();
 }
 

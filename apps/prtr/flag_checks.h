@@ -1,7 +1,9 @@
-// apps/prtr/flag_checks.h: CLI11 validators the commands share. CLI::Range lets NaN through
-// (every comparison with NaN is false), and an infinite angle or exposure only fails deep in
-// the pipeline with a message that does not name the flag, so floating-point flags are
-// checked for finiteness where they are parsed: exit 2 naming the flag.
+// apps/prtr/flag_checks.h: the validators every command's numeric flags use, so that every
+// range error reads the same: the flag, the range a person would write and the value given
+// ("--clusters: must be an integer between 1 and 65536, got '0'"). Each parses the text
+// itself: CLI11 would turn an empty value into 0, wrap "-1" into 2^64 - 1 for an unsigned
+// flag, let NaN through a range (every comparison with NaN is false) and print a range's
+// unbounded end as a 300-digit number. Exit 2 naming the flag.
 #pragma once
 
 #include "commands.h"
@@ -10,21 +12,88 @@
 
 #include <CLI/CLI.hpp>
 
+#include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace prtr_app {
 
-inline CLI::Validator finite_number() {
+namespace detail {
+
+inline std::string quoted(const std::string& text) {
+  return "'" + text + "'";
+}
+
+// Whole-text integer parse; nullopt for empty text, trailing characters or overflow.
+inline std::optional<long long> parse_integer(const std::string& text) {
+  long long value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end) return std::nullopt;
+  return value;
+}
+
+// "%g" with up to 9 significant digits: 1e+06, 0.01, 65536.
+inline std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+}  // namespace detail
+
+// An integer in [lo, hi].
+inline CLI::Validator integer_in(long long lo, long long hi) {
+  const std::string range = "an integer between " + std::to_string(lo) + " and " +
+                            std::to_string(hi);
   return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
-        if (!std::isfinite(value)) return "'" + text + "' is not a finite number";
+      [lo, hi, range](std::string& text) -> std::string {
+        const auto v = detail::parse_integer(text);
+        if (!v || *v < lo || *v > hi) return "must be " + range + ", got " + detail::quoted(text);
         return {};
       },
-      "FINITE");
+      "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+// Any unsigned 64-bit integer (seeds): digits only, so "-1" is refused rather than wrapped.
+inline CLI::Validator unsigned_integer() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        std::uint64_t value = 0;
+        const char* end = text.data() + text.size();
+        const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+        if (text.empty() || ec != std::errc() || ptr != end)
+          return "must be a whole number from 0 to 2^64 - 1, got " + detail::quoted(text);
+        return {};
+      },
+      "UINT64");
+}
+
+// A finite real number in [lo, hi].
+inline CLI::Validator number_in(double lo, double hi) {
+  const std::string range = "a number between " + detail::number_text(lo) + " and " +
+                            detail::number_text(hi);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        double value = 0;
+        const char* end = text.data() + text.size();
+        const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+        if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(value) ||
+            value < lo || value > hi)
+          return "must be " + range + ", got " + detail::quoted(text);
+        return {};
+      },
+      "NUMBER in [" + detail::number_text(lo) + ", " + detail::number_text(hi) + "]");
+}
+
+// Angles in degrees: a million degrees is still exact enough to turn by, and bounds the
+// products that follow.
+inline CLI::Validator angle_degrees() {
+  return number_in(-1e6, 1e6);
 }
 
 // Refuses, before any work, an output that would destroy an input, replace another output or

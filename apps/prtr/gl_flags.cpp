@@ -1,6 +1,7 @@
 #include "gl_flags.h"
 
 #include "commands.h"
+#include "flag_checks.h"
 
 namespace prtr_app {
 
@@ -20,7 +21,7 @@ void add_gl_flags(CLI::App* cmd, GlFlags& flags) {
                   "EGL device index for --gl egl (prtr gl-info lists them; default: the first "
                   "GPU, else Mesa's software device)")
       ->envname("PRTR_GL_DEVICE")
-      ->check(CLI::NonNegativeNumber);
+      ->check(integer_in(0, 1 << 20));
 }
 
 render::GlSelection gl_selection(const GlFlags& flags) {

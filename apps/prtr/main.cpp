@@ -1,6 +1,7 @@
 // prtr: the command-line front end of the PRT engine. One binary, one subcommand per
 // workflow; see README.md.
 #include "commands.h"
+#include "flag_checks.h"
 #include "start_sweep.h"
 
 #include <tbb/global_control.h>
@@ -20,7 +21,7 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads,
                  "Worker threads at most (0: every core; under mpirun, each rank gets the node's "
                  "cores divided by its ranks). Results do not depend on it")
-      ->check(CLI::Range(0, 65536))
+      ->check(prtr_app::integer_in(0, 65536))
       ->capture_default_str();
 
   std::map<const CLI::App*, prtr_app::Runner> runners;

@@ -11,21 +11,23 @@ namespace prtr_app {
 
 void add_view_flags(CLI::App* cmd, ViewFlags& f) {
   cmd->add_option("--width", f.width, "Image width")
-      ->check(CLI::Range(1, 16384))
+      ->check(integer_in(1, 16384))
       ->capture_default_str();
   cmd->add_option("--height", f.height, "Image height")
-      ->check(CLI::Range(1, 16384))
+      ->check(integer_in(1, 16384))
       ->capture_default_str();
   cmd->add_option("--eye", f.eye, "Camera position x,y,z (default: frames the bounding sphere)");
   cmd->add_option("--target", f.target, "Camera target x,y,z (default: the sphere's centre)");
   cmd->add_option("--up", f.up, "Camera up x,y,z (default: 0,1,0)");
+  // Open at both ends; the camera refuses 0 and 180 by name.
   cmd->add_option("--fov", f.fov, "Vertical field of view (degrees)")
-      ->check(finite_number())
+      ->check(number_in(0, 180))
       ->capture_default_str();
   cmd->add_option("--background", f.background, "probe, black, or a colour R,G,B")
       ->capture_default_str();
+  // 2^64 times a radiance of 1e20 is still a float; past it the PNG would be all Inf.
   cmd->add_option("--exposure", f.exposure, "PNG exposure in stops")
-      ->check(finite_number())
+      ->check(number_in(-64, 64))
       ->capture_default_str();
   cmd->add_option("--axis", f.axis, "Environment rotation axis x,y,z")->capture_default_str();
 }
