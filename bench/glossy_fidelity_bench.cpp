@@ -88,9 +88,9 @@ prt::TransferSet bake_sphere(const meshes::Mesh& sphere, const prt::Material& ma
 Eigen::Vector3d radiance(const prt::TransferSet& t, const meshes::Mesh& mesh, std::size_t p,
                          prt::ViewFit fit, const prt::ShLighting& lighting,
                          const Eigen::Vector3d& w) {
-  const Eigen::Vector3d local = prt::clamp_to_horizon(
-      Eigen::Vector3d(mesh.tangents[p].cast<double>().dot(w),
-                      mesh.bitangents[p].cast<double>().dot(w), mesh.normals[p].cast<double>().dot(w)));
+  const Eigen::Vector3d local = prt::clamp_to_horizon(Eigen::Vector3d(
+      mesh.tangents[p].cast<double>().dot(w), mesh.bitangents[p].cast<double>().dot(w),
+      mesh.normals[p].cast<double>().dot(w)));
   const int n = t.coefficient_count();
   std::vector<double> y(n);
   prt::view_basis_eval(fit, t.order, local, y.data());
@@ -261,8 +261,8 @@ int main(int argc, char** argv) {
     const std::string dir = "/usr/share/blender/datafiles/studiolights/world/";
     probe_paths = {dir + "forest.exr", dir + "city.exr"};
   }
-  const std::vector<int> orders = quick ? std::vector<int>{2, 6, 10}
-                                        : std::vector<int>{2, 4, 6, 8, 10};
+  const std::vector<int> orders =
+      quick ? std::vector<int>{2, 6, 10} : std::vector<int>{2, 4, 6, 8, 10};
   const auto start = Clock::now();
   const meshes::Mesh sphere = meshes::make_sphere(1.f, 24, 14);
   std::printf("# glossy fidelity: unoccluded sphere (%zu vertices), %d samples, lambda %g\n\n",
@@ -289,8 +289,7 @@ int main(int argc, char** argv) {
       exact.push_back(exact_probe(probe, sphere, nm.material, views));
 
     std::printf("## %s\n\n", nm.name.c_str());
-    std::printf(
-        "| fit | order | white sky: at 0 deg | p99 abs 0-70 deg | max abs |");
+    std::printf("| fit | order | white sky: at 0 deg | p99 abs 0-70 deg | max abs |");
     for (std::size_t q = 0; q < probes_in.size(); ++q)
       std::printf(" %s rel. RMSE | bias |", probes_in[q].name().c_str());
     std::printf(" rel. RMSE by angle %s (0/15/30/45/60/75) |\n", probes_in[0].name().c_str());
@@ -366,7 +365,6 @@ int main(int argc, char** argv) {
     }
     std::printf("\n");
   }
-  std::printf("total %.1f s\n",
-              std::chrono::duration<double>(Clock::now() - start).count());
+  std::printf("total %.1f s\n", std::chrono::duration<double>(Clock::now() - start).count());
   return 0;
 }

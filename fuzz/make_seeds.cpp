@@ -292,15 +292,16 @@ int main(int argc, char** argv) {
     mesh_seeds(out, "bunny_patch", patch(meshes::load_mesh(bunny), 400));
     // Hostile cases that once got past the guards: a line loop whose indices name the float
     // position accessor (crashed Assimp), and an OBJ whose mtllib names /dev/zero.
-    write(out / "mesh_gltf" / "float_indices.gltf",
-          R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
-          R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":0,"mode":2}]}],)"
-          R"("buffers":[{"byteLength":72,"uri":"data:application/octet-stream;base64,)"
-          R"(AAAAAAAiYnl0ZUxlbmd0aCI6IDcyfV0sICJidWZmZXJWaWV3cwAED6AAAAAAAIA/AAACAAEAAAABAAMAAAADAAIAAQECAAMA"}],)"
-          R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,)"
-          R"("byteLength":24}],"accessors":[{"bufferView":0,"componentType":5126,"count":4,)"
-          R"("type":"VEC3","min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,)"
-          R"("count":12,"type":"SCALAR"}]})");
+    write(
+        out / "mesh_gltf" / "float_indices.gltf",
+        R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":0,"mode":2}]}],)"
+        R"("buffers":[{"byteLength":72,"uri":"data:application/octet-stream;base64,)"
+        R"(AAAAAAAiYnl0ZUxlbmd0aCI6IDcyfV0sICJidWZmZXJWaWV3cwAED6AAAAAAAIA/AAACAAEAAAABAAMAAAADAAIAAQECAAMA"}],)"
+        R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,)"
+        R"("byteLength":24}],"accessors":[{"bufferView":0,"componentType":5126,"count":4,)"
+        R"("type":"VEC3","min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,)"
+        R"("count":12,"type":"SCALAR"}]})");
     write(out / "mesh_obj" / "mtllib.obj",
           "mtllib ../../../../../../../../dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     for (const char* name : {"cube", "asteroid-low"}) {

@@ -87,10 +87,8 @@ TEST(OutputPath, SpecialFilesAreRefusedAndKept) {
   }
   EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
-  EXPECT_NE(common::output_target_problem("/dev/null").find("character device"),
-            std::string::npos);
-  EXPECT_NE(common::output_target_problem(fifo.parent_path()).find("directory"),
-            std::string::npos);
+  EXPECT_NE(common::output_target_problem("/dev/null").find("character device"), std::string::npos);
+  EXPECT_NE(common::output_target_problem(fifo.parent_path()).find("directory"), std::string::npos);
   EXPECT_EQ(common::output_target_problem(scratch("new.bin")), "");
 }
 

@@ -558,28 +558,28 @@ TEST(LambertMatrix, NumericalMatchesClosedFormAndIsRankOne) {
   for (const prt::ViewFit fit :
        {prt::ViewFit::kHemisphere, prt::ViewFit::kEven, prt::ViewFit::kLeastSquares,
         prt::ViewFit::kHemisphericalHarmonics}) {
-  const Eigen::MatrixXd numerical = prt::brdf_matrix(
-      make_material(prt::MaterialKind::kLambert, float(rho), 0.f), kOrder, 0, {}, fit);
-  const Eigen::MatrixXd closed = prt::lambert_brdf_matrix(double(float(rho)), kOrder, fit);
-  // The default Lambert grid is exact (material.cpp), so 1e-6 is far above rounding (~1e-15).
-  EXPECT_LT((numerical - closed).cwiseAbs().maxCoeff(), 1e-6) << prt::view_fit_name(fit);
-  EXPECT_GT(closed.cwiseAbs().maxCoeff(), 0.1);
+    const Eigen::MatrixXd numerical = prt::brdf_matrix(
+        make_material(prt::MaterialKind::kLambert, float(rho), 0.f), kOrder, 0, {}, fit);
+    const Eigen::MatrixXd closed = prt::lambert_brdf_matrix(double(float(rho)), kOrder, fit);
+    // The default Lambert grid is exact (material.cpp), so 1e-6 is far above rounding (~1e-15).
+    EXPECT_LT((numerical - closed).cwiseAbs().maxCoeff(), 1e-6) << prt::view_fit_name(fit);
+    EXPECT_GT(closed.cwiseAbs().maxCoeff(), 0.1);
 
-  for (const Eigen::MatrixXd& b : {numerical, closed}) {
-    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(b);
-    const Eigen::VectorXd sigma = svd.singularValues();
-    EXPECT_GT(sigma[0], 0.1);
-    EXPECT_LT(sigma[1], 1e-6 * sigma[0]);
-    for (int i = 0; i < kN; ++i) {
-      for (int j = 0; j < kN; ++j) {
-        const int mi = i - prt::sh_index(prt::sh_band(i), 0);
-        const int mj = j - prt::sh_index(prt::sh_band(j), 0);
-        if (mi != 0 || mj != 0) {
-          EXPECT_NEAR(b(i, j), 0.0, 1e-12) << i << "," << j;
+    for (const Eigen::MatrixXd& b : {numerical, closed}) {
+      const Eigen::JacobiSVD<Eigen::MatrixXd> svd(b);
+      const Eigen::VectorXd sigma = svd.singularValues();
+      EXPECT_GT(sigma[0], 0.1);
+      EXPECT_LT(sigma[1], 1e-6 * sigma[0]);
+      for (int i = 0; i < kN; ++i) {
+        for (int j = 0; j < kN; ++j) {
+          const int mi = i - prt::sh_index(prt::sh_band(i), 0);
+          const int mj = j - prt::sh_index(prt::sh_band(j), 0);
+          if (mi != 0 || mj != 0) {
+            EXPECT_NEAR(b(i, j), 0.0, 1e-12) << i << "," << j;
+          }
         }
       }
     }
-  }
   }
 
   // A coloured albedo gives each channel its own rho.
@@ -616,8 +616,8 @@ TEST(LambertMatrix, ConstantLightGivesAlbedoTimesHemisphereIntegrals) {
             1e-8);
   // The default fit represents the constant exit radiance rho L itself: y(v)^T B l = rho L.
   const Eigen::VectorXd e = prt::lambert_brdf_matrix(rho, kOrder) * l;
-  for (const Eigen::Vector3d& v : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.6, 0, 0.8),
-                                  Eigen::Vector3d(1, 0, 0)}) {
+  for (const Eigen::Vector3d& v :
+       {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.6, 0, 0.8), Eigen::Vector3d(1, 0, 0)}) {
     EXPECT_NEAR(prt::sh_expand(e, v), rho * radiance, 1e-12);
   }
 }
@@ -710,8 +710,8 @@ TEST(BrdfMatrix, DefaultGridHasConverged) {
           m, kOrder, 0, {2 * q.view_theta, 2 * q.view_phi, 2 * q.light_theta, 2 * q.light_phi},
           fit);
       const double difference = (coarse - fine).norm() / fine.norm();
-      std::cout << prt::material_name(m.kind) << " e=" << m.exponent << " m=" << m.roughness
-                << " " << prt::view_fit_name(fit) << ": default vs 2x grid " << difference << "\n";
+      std::cout << prt::material_name(m.kind) << " e=" << m.exponent << " m=" << m.roughness << " "
+                << prt::view_fit_name(fit) << ": default vs 2x grid " << difference << "\n";
       EXPECT_LT(difference, bound) << prt::material_name(m.kind) << " " << prt::view_fit_name(fit);
     }
   }
@@ -730,7 +730,8 @@ TEST(BrdfMatrix, DefaultGridTiming) {
                         Case{cook_torrance(0.3f), "cook_torrance_m0.3"}}) {
     const prt::BrdfQuadrature q = prt::resolve_brdf_quadrature(c.material, kOrder);
     const auto start = std::chrono::steady_clock::now();
-    const Eigen::MatrixXd b = prt::brdf_matrix(c.material, kOrder, 0, {}, prt::ViewFit::kHemisphere);
+    const Eigen::MatrixXd b =
+        prt::brdf_matrix(c.material, kOrder, 0, {}, prt::ViewFit::kHemisphere);
     const double elapsed = seconds_since(start);
     std::cout << "brdf_matrix order 6 " << c.label << ": view " << q.view_theta << " x "
               << q.view_phi << ", light " << q.light_theta << " x " << q.light_phi << ", "

@@ -279,8 +279,7 @@ TEST(GltfErrors, AccessorsMustHaveTheTypeOfTheirRole) {
                     "indices accessor 0 is not SCALAR of unsigned");
   Scene positions = two_mesh_scene();
   positions.gltf["meshes"][1]["primitives"][0]["attributes"]["POSITION"] = 2;  // the indices
-  expect_load_error(write_file("scalar_positions.gltf", as_gltf(positions)),
-                    "POSITION accessor");
+  expect_load_error(write_file("scalar_positions.gltf", as_gltf(positions)), "POSITION accessor");
   Scene mode = two_mesh_scene();
   mode.gltf["meshes"][0]["primitives"][0]["mode"] = 9;
   expect_load_error(write_file("mode9.gltf", as_gltf(mode)), "mode 9");

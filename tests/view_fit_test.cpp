@@ -6,13 +6,13 @@
 //  - the engine's own bake of an unoccluded sphere against those albedos under a white sky,
 //    against the diffuse path for Lambert, and against an exact per-pixel integral of a real
 //    probe at several view angles.
+#include "prt/view_fit.h"
 #include "meshes/procedural.h"
 #include "probes/load.h"
 #include "prt/bake.h"
 #include "prt/material.h"
 #include "prt/projection.h"
 #include "prt/sh.h"
-#include "prt/view_fit.h"
 
 #include <gtest/gtest.h>
 
@@ -77,7 +77,8 @@ prt::Material lambert(float albedo) {
 }
 
 prt::TransferSet bake_sphere(const meshes::Mesh& sphere, const prt::Material& m, int order,
-                             prt::ViewFit fit, prt::TransferKind kind = prt::TransferKind::kGlossy) {
+                             prt::ViewFit fit,
+                             prt::TransferKind kind = prt::TransferKind::kGlossy) {
   prt::BakeOptions o;
   o.kind = kind;
   o.order = order;
@@ -314,8 +315,8 @@ TEST(GlossyFidelity, LambertThroughTheGlossyPathEqualsTheDiffusePath) {
   const meshes::Mesh sphere = meshes::make_sphere(1.f, 12, 8);
   const int order = 6, n = prt::sh_count(order);
   const prt::TransferSet glossy = bake_sphere(sphere, lambert(0.6f), order, prt::kDefaultViewFit);
-  const prt::TransferSet diffuse = bake_sphere(sphere, lambert(0.6f), order, prt::kDefaultViewFit,
-                                               prt::TransferKind::kDiffuse);
+  const prt::TransferSet diffuse =
+      bake_sphere(sphere, lambert(0.6f), order, prt::kDefaultViewFit, prt::TransferKind::kDiffuse);
   prt::ShLighting l = prt::ShLighting::Random(n, 3);
   l.row(0) += Eigen::RowVector3d::Constant(4.0);
   double across_views = 0, across_paths = 0, scale = 0;
@@ -405,7 +406,8 @@ TEST(GlossyFidelity, RealProbeMatchesTheExactIntegralAndConvergesWithOrder) {
   double previous = 1e9;
   for (int order : {2, 4, 6, 8, 10}) {
     const prt::ShLighting l = prt::project(probe, order);
-    const ErrorPair e = probe_error(bake_sphere(sphere, m, order, prt::kDefaultViewFit), sphere, l, c);
+    const ErrorPair e =
+        probe_error(bake_sphere(sphere, m, order, prt::kDefaultViewFit), sphere, l, c);
     std::cout << "order " << order << ": relative RMSE " << e.rmse << ", bias " << e.bias << "\n";
     EXPECT_LT(e.rmse, previous) << "order " << order;
     previous = e.rmse;

@@ -1,6 +1,6 @@
 // apps/prtr/bake_flags.h: the bake flags (--kind, --order, --samples, --bounces, --seed,
-// --material and its parameters, --masking, --view-fit, --ray-offset), shared by every command that bakes: prtr bake,
-// and prtr relight / overdraw through the cache.
+// --material and its parameters, --masking, --view-fit, --ray-offset), shared by every command that
+// bakes: prtr bake, and prtr relight / overdraw through the cache.
 #pragma once
 
 #include "prt/bake.h"

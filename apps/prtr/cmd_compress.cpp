@@ -1,8 +1,8 @@
 // prtr compress TRANSFER --mesh MESH -o FILE: clustered PCA of a bake (LBG or iterative CPCA,
 // optional geometry coherence and overdraw-aware reassignment), with a one-screen report.
 #include "commands.h"
-#include "flag_checks.h"
 #include "compress_flags.h"
+#include "flag_checks.h"
 #include "json_output.h"
 #include "mpi_world.h"
 

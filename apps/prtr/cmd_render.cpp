@@ -209,11 +209,10 @@ Runner add_render_command(CLI::App& app) {
 
   return [opt, cmd] {
     const Options& o = *opt;
-    check_outputs({{"-o", o.output}, {"--png", o.png}},
-                  {{"COMPRESSED", o.compressed},
-                   {"--probe", o.probe},
-                   {"--mesh", o.mesh},
-                   {"--transfer", o.transfer}});
+    check_outputs({{"-o", o.output}, {"--png", o.png}}, {{"COMPRESSED", o.compressed},
+                                                         {"--probe", o.probe},
+                                                         {"--mesh", o.mesh},
+                                                         {"--transfer", o.transfer}});
     const render::GlSelection gl = gl_selection(o.gl);
     render::RendererOptions ro = renderer_options(o, cmd);
     const render::Background background = resolve_background(o.view);

@@ -48,8 +48,8 @@ inline std::string number_text(double v) {
 
 // An integer in [lo, hi].
 inline CLI::Validator integer_in(long long lo, long long hi) {
-  const std::string range = "an integer between " + std::to_string(lo) + " and " +
-                            std::to_string(hi);
+  const std::string range =
+      "an integer between " + std::to_string(lo) + " and " + std::to_string(hi);
   return CLI::Validator(
       [lo, hi, range](std::string& text) -> std::string {
         const auto v = detail::parse_integer(text);
@@ -75,8 +75,8 @@ inline CLI::Validator unsigned_integer() {
 
 // A finite real number in [lo, hi].
 inline CLI::Validator number_in(double lo, double hi) {
-  const std::string range = "a number between " + detail::number_text(lo) + " and " +
-                            detail::number_text(hi);
+  const std::string range =
+      "a number between " + detail::number_text(lo) + " and " + detail::number_text(hi);
   return CLI::Validator(
       [lo, hi, range](std::string& text) -> std::string {
         double value = 0;

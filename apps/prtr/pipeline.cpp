@@ -199,8 +199,7 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
       << o.order << " samples " << o.samples << " bounces " << o.bounces << " seed " << o.seed
       << " ray_offset " << o.ray_offset << " material " << int(m.kind) << ' ' << m.albedo.x() << ' '
       << m.albedo.y() << ' ' << m.albedo.z() << ' ' << m.specular << ' ' << m.exponent << ' '
-      << m.roughness << ' ' << m.f0 << " masking " << int(m.masking) << " view "
-      << int(o.view_fit);
+      << m.roughness << ' ' << m.f0 << " masking " << int(m.masking) << " view " << int(o.view_fit);
   CacheResult r{cache_dir / ("bake-" + hex(hash_text(key.str())) + ".prtx"), false};
   sweep(cache_dir);
   if (fs::exists(r.path)) {

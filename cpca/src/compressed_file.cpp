@@ -251,14 +251,14 @@ std::string value_problem(const CompressedSet& set) {
   };
   for (std::size_t i = 0; i < set.weights.size(); ++i) {
     if (bad(set.weights[i])) {
-      return what(set.weights[i]) + "weight " + num(set.weights[i]) + " at vertex " + std::to_string(i / n) +
-             ", component " + std::to_string(i % n);
+      return what(set.weights[i]) + "weight " + num(set.weights[i]) + " at vertex " +
+             std::to_string(i / n) + ", component " + std::to_string(i % n);
     }
   }
   for (std::size_t i = 0; i < set.means.size(); ++i) {
     if (bad(set.means[i])) {
-      return what(set.means[i]) + "mean value " + num(set.means[i]) + " at cluster " + std::to_string(i / d) +
-             ", entry " + std::to_string(i % d);
+      return what(set.means[i]) + "mean value " + num(set.means[i]) + " at cluster " +
+             std::to_string(i / d) + ", entry " + std::to_string(i % d);
     }
   }
   for (std::size_t i = 0; i < set.bases.size(); ++i) {

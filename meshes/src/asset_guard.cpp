@@ -345,7 +345,8 @@ void check_meshes(const json& root) {
         const bool type_ok = t != accessor.end() && t->is_string() && t->get<std::string>() == type;
         bool component_ok = false;
         if (c != accessor.end() && c->is_number_unsigned())
-          for (std::uint64_t allowed : component_types) component_ok |= c->get<std::uint64_t>() == allowed;
+          for (std::uint64_t allowed : component_types)
+            component_ok |= c->get<std::uint64_t>() == allowed;
         if (!type_ok || !component_ok) {
           refuse(at + "'s " + role + " accessor " + std::to_string(a) + " is not " + wanted +
                  "; the file is damaged");

@@ -200,10 +200,10 @@ Setup make_setup(const BakeOptions& o, int channels, double* brdf_seconds) {
   if (o.kind == TransferKind::kGlossy) {
     const auto start = Clock::now();
     for (int c = 0; c < channels; ++c) {
-      s.brdf.push_back(o.brdf_override ? o.brdf_override->cast<float>().eval()
-                                       : brdf_matrix(o.material, o.order, c, {}, o.view_fit)
-                                             .cast<float>()
-                                             .eval());
+      s.brdf.push_back(
+          o.brdf_override
+              ? o.brdf_override->cast<float>().eval()
+              : brdf_matrix(o.material, o.order, c, {}, o.view_fit).cast<float>().eval());
     }
     *brdf_seconds = seconds_since(start);
   }

@@ -61,8 +61,13 @@ Lobe make_lobe(const Material& material, int channel) {
     rho_d = material.albedo[channel];
   }
   const double m = material.roughness;
-  return {material.kind, rho_d,        double(material.specular), double(material.exponent),
-          m * m,         double(material.f0), material.masking};
+  return {material.kind,
+          rho_d,
+          double(material.specular),
+          double(material.exponent),
+          m * m,
+          double(material.f0),
+          material.masking};
 }
 
 // The header's formulas. v and s are unit vectors in the local frame.
@@ -364,7 +369,8 @@ Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
   const Eigen::Index view_count = view.directions.cols();
   const Eigen::Index light_count = light.directions.cols();
 
-  const Eigen::MatrixXd view_side = view_projection(fit, order, view.directions, view.weights, view_lambda);
+  const Eigen::MatrixXd view_side =
+      view_projection(fit, order, view.directions, view.weights, view_lambda);
   ShBatchD y_light;
   sh_eval_batch(order, light.directions, y_light);
   // Ys diag(s.z w)^T, light_count x n: the light side of every product, folded once.
@@ -379,8 +385,8 @@ Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
                            light.directions.row(2).transpose().array().inverse(),
                            {}};
   if (lobe.kind == MaterialKind::kCookTorrance && lobe.masking == Masking::kSmith) {
-    light_arrays.smith = light_arrays.z.unaryExpr(
-        [&](double z) { return 1.0 + smith_lambda(z, lobe.m2); });
+    light_arrays.smith =
+        light_arrays.z.unaryExpr([&](double z) { return 1.0 + smith_lambda(z, lobe.m2); });
   }
 
   // Work unit: kViewChunk view nodes against all light nodes, in blocks of kLightBlock so

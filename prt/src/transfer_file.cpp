@@ -428,10 +428,10 @@ void check_finite(const fs::path& file, const TransferSet& shape, const float* d
                   std::size_t floats, std::uint64_t first) {
   for (std::size_t i = 0; i < floats; ++i) {
     if (!(std::abs(data[i]) <= kMaxTransferValue)) {
-      throw std::invalid_argument(file.string() + ": cannot write the transfer set: " +
-                                  (std::isfinite(data[i]) ? "value beyond +-1e12 "
-                                                          : "non-finite value ") +
-                                  num(data[i]) + " at " + locate(shape, first + i));
+      throw std::invalid_argument(
+          file.string() + ": cannot write the transfer set: " +
+          (std::isfinite(data[i]) ? "value beyond +-1e12 " : "non-finite value ") + num(data[i]) +
+          " at " + locate(shape, first + i));
     }
   }
 }

@@ -16,11 +16,10 @@
 namespace prt {
 namespace {
 
-constexpr common::EnumName<ViewFit> kViewFitNames[] = {
-    {ViewFit::kHemisphere, "hemisphere"},
-    {ViewFit::kEven, "even"},
-    {ViewFit::kLeastSquares, "least-squares"},
-    {ViewFit::kHemisphericalHarmonics, "hsh"}};
+constexpr common::EnumName<ViewFit> kViewFitNames[] = {{ViewFit::kHemisphere, "hemisphere"},
+                                                       {ViewFit::kEven, "even"},
+                                                       {ViewFit::kLeastSquares, "least-squares"},
+                                                       {ViewFit::kHemisphericalHarmonics, "hsh"}};
 
 // HSH's direction: cos theta' = 2 z - 1 and the tangent part scaled by sin theta' / sin theta,
 // which is sqrt(4 z / (1 + z)) in closed form (no division by sin theta at the pole).

@@ -92,9 +92,9 @@ void ShadingConstants::compute(const Eigen::Ref<const prt::ShLighting>& lighting
 
 Eigen::Vector3d local_view(const meshes::Mesh& mesh, std::size_t p, const Eigen::Vector3d& eye) {
   const Eigen::Vector3d v = (eye - mesh.positions[p].cast<double>()).normalized();
-  return prt::clamp_to_horizon(
-      Eigen::Vector3d(mesh.tangents[p].cast<double>().dot(v),
-                      mesh.bitangents[p].cast<double>().dot(v), mesh.normals[p].cast<double>().dot(v)));
+  return prt::clamp_to_horizon(Eigen::Vector3d(mesh.tangents[p].cast<double>().dot(v),
+                                               mesh.bitangents[p].cast<double>().dot(v),
+                                               mesh.normals[p].cast<double>().dot(v)));
 }
 
 void shade_vertices(const cpca::CompressedSet& set, const ConstantLayout& layout,

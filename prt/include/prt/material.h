@@ -79,8 +79,8 @@ BrdfQuadrature resolve_brdf_quadrature(const Material& material, int order,
 // by f_r evaluations (view nodes x light nodes) and runs in parallel; a glossy Phong lobe at
 // order 6 takes well under a second.
 Eigen::MatrixXd brdf_matrix(const Material& material, int order, int channel,
-                            const BrdfQuadrature& quadrature = {},
-                            ViewFit fit = kDefaultViewFit, double view_lambda = kViewFitLambda);
+                            const BrdfQuadrature& quadrature = {}, ViewFit fit = kDefaultViewFit,
+                            double view_lambda = kViewFitLambda);
 
 // Directional albedo int_{s.z>0} f_r(v, s) s.z ds of one channel toward the local view v
 // (v.z > 0), by a dense product quadrature independent of brdf_matrix's grids (the oracle of

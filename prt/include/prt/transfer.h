@@ -35,7 +35,7 @@ struct TransferSet {
   std::uint64_t seed = 0;  // of the direction set
   Material material;
   ViewFit view_fit = kDefaultViewFit;  // glossy: how B's view side was fitted (prt/view_fit.h)
-  std::uint64_t mesh_hash = 0;  // meshes::content_hash of the baked mesh
+  std::uint64_t mesh_hash = 0;         // meshes::content_hash of the baked mesh
   // FNV-1a of the payload as recorded in the file this set was read from (0 for a set that
   // was never written); a compressed set records it to tie itself to this bake.
   std::uint64_t payload_checksum = 0;
