@@ -234,6 +234,28 @@ Error error_of(const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::V
   return {std::sqrt(se / sr), d / r};
 }
 
+// The probe columns of one table row: relative RMSE and bias per probe, then the first
+// probe's RMSE by view angle. `evaluate` gives the radiance of every view under lighting l.
+template <class Evaluate>
+void print_probe_errors(const std::vector<probes::Probe>& probes_in, int order,
+                        const std::vector<std::vector<Eigen::Vector3d>>& exact,
+                        const std::vector<View>& views, const std::vector<int>& angles,
+                        const Evaluate& evaluate) {
+  std::vector<Error> by_angle;
+  for (std::size_t q = 0; q < probes_in.size(); ++q) {
+    const std::vector<Eigen::Vector3d> x = evaluate(prt::project(probes_in[q], order));
+    const Error e = error_of(x, exact[q], views);
+    std::printf(" %.2f%% | %+.2f%% |", 100 * e.rmse, 100 * e.bias);
+    if (q == 0)
+      for (int a : angles) by_angle.push_back(error_of(x, exact[q], views, a));
+  }
+  std::printf(" ");
+  for (std::size_t a = 0; a < by_angle.size(); ++a)
+    std::printf("%s%.1f", a ? "/" : "", 100 * by_angle[a].rmse);
+  std::printf(" |\n");
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -307,21 +329,9 @@ int main(int argc, char** argv) {
       const prt::TransferSet light = prt::bake(sphere, o);
       const ExactViewSide exact_view(order);
       std::printf("| exact view side | %d | | | |", order);
-      std::vector<Error> by_angle;
-      for (std::size_t q = 0; q < probes_in.size(); ++q) {
-        const prt::ShLighting l = prt::project(probes_in[q], order);
-        const std::vector<Eigen::Vector3d> x =
-            light_side_only(exact_view, light, sphere, nm.material, l, views);
-        const Error e = error_of(x, exact[q], views);
-        std::printf(" %.2f%% | %+.2f%% |", 100 * e.rmse, 100 * e.bias);
-        if (q == 0)
-          for (int a : angles) by_angle.push_back(error_of(x, exact[q], views, a));
-      }
-      std::printf(" ");
-      for (std::size_t a = 0; a < by_angle.size(); ++a)
-        std::printf("%s%.1f", a ? "/" : "", 100 * by_angle[a].rmse);
-      std::printf(" |\n");
-      std::fflush(stdout);
+      print_probe_errors(probes_in, order, exact, views, angles, [&](const prt::ShLighting& l) {
+        return light_side_only(exact_view, light, sphere, nm.material, l, views);
+      });
     }
     for (prt::ViewFit fit : fits) {
       for (int order : orders) {
@@ -345,22 +355,12 @@ int main(int argc, char** argv) {
         const double p99 = abs_err[std::size_t(std::floor(0.99 * double(abs_err.size() - 1)))];
         std::printf("| %s | %d | %+.2f%% | %.2f%% | %.2f%% |", prt::view_fit_name(fit), order,
                     100 * sky_err[0], 100 * p99, 100 * abs_err.back());
-        std::vector<Error> by_angle;
-        for (std::size_t q = 0; q < probes_in.size(); ++q) {
-          const prt::ShLighting l = prt::project(probes_in[q], order);
+        print_probe_errors(probes_in, order, exact, views, angles, [&](const prt::ShLighting& l) {
           std::vector<Eigen::Vector3d> x(views.size());
           for (std::size_t i = 0; i < views.size(); ++i)
             x[i] = radiance(t, sphere, views[i].vertex, fit, l, views[i].w);
-          const Error e = error_of(x, exact[q], views);
-          std::printf(" %.2f%% | %+.2f%% |", 100 * e.rmse, 100 * e.bias);
-          if (q == 0)
-            for (int a : angles) by_angle.push_back(error_of(x, exact[q], views, a));
-        }
-        std::printf(" ");
-        for (std::size_t a = 0; a < by_angle.size(); ++a)
-          std::printf("%s%.1f", a ? "/" : "", 100 * by_angle[a].rmse);
-        std::printf(" |\n");
-        std::fflush(stdout);
+          return x;
+        });
       }
     }
     std::printf("\n");
