@@ -308,7 +308,8 @@ void check_accessors(const json& root, const std::vector<std::uint64_t>& views) 
 }
 
 void check_meshes(const json& root) {
-  const std::size_t accessors = array_at(root, "accessors").size();
+  const json& accessor_list = array_at(root, "accessors");
+  const std::size_t accessors = accessor_list.size();
   const json& meshes = array_at(root, "meshes");
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     const std::string where = "mesh " + std::to_string(m);
@@ -335,7 +336,6 @@ void check_meshes(const json& root) {
       }
       // Each accessor must have the type its role reads: Assimp trusts the roles, so float
       // positions named as indices were read as indices (and crashed the line-loop path).
-      const json& accessor_list = array_at(root, "accessors");
       const auto expect_role = [&](std::uint64_t a, const char* role, const char* type,
                                    std::initializer_list<std::uint64_t> component_types,
                                    const char* wanted) {

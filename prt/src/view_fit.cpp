@@ -11,7 +11,6 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 namespace prt {
 namespace {
@@ -63,13 +62,18 @@ Eigen::MatrixXd view_projection(ViewFit fit, int order, const Eigen::Matrix3Xd& 
     throw std::invalid_argument("view fit lambda must be in (0, 1], got " + std::to_string(lambda));
   }
   const int n = sh_count(order);
-  const Eigen::Index count = directions.cols();
-  Eigen::MatrixXd y(n, count);
-  std::vector<double> values(n);
-  for (Eigen::Index k = 0; k < count; ++k) {
-    view_basis_eval(fit, order, directions.col(k), values.data());
-    for (int i = 0; i < n; ++i) y(i, k) = values[i];
+  // The view basis at every node, by the batched SH evaluation (HSH: at remapped nodes).
+  ShBatchD batch;
+  if (fit == ViewFit::kHemisphericalHarmonics) {
+    Eigen::Matrix3Xd remapped(3, directions.cols());
+    for (Eigen::Index k = 0; k < directions.cols(); ++k)
+      remapped.col(k) = hsh_direction(directions.col(k));
+    sh_eval_batch(order, remapped, batch);
+    batch *= std::sqrt(2.0);
+  } else {
+    sh_eval_batch(order, directions, batch);
   }
+  const Eigen::MatrixXd y = batch;
   Eigen::MatrixXd projection = y * weights.asDiagonal();  // int_{v.z>0} basis_i (.)
   switch (fit) {
     case ViewFit::kHemisphere:
