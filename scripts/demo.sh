@@ -6,7 +6,7 @@
 # and a contact sheet to out/relight/. A second run finds the bake and compression cached.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+bash scripts/setup.sh --main
 
 mesh=/usr/share/glmark2/models/bunny.obj
 probe=/usr/share/blender/datafiles/studiolights/world/forest.exr

@@ -10,23 +10,40 @@
 # ffmpeg (the MP4 of prtr relight, and ffprobe for its test) and python3-matplotlib (the plot
 # of prtr overdraw, scripts/plot_overdraw.py) are run, not linked: without them prtr still
 # works and says how to get the missing output, but the tests that check it are skipped.
+#
+#   bash scripts/setup.sh          # everything: the test command's set-up
+#   bash scripts/setup.sh --main   # only what `prtr relight` needs (the main job's set-up): no
+#                                  # test or benchmark packages, and only the prtr target
 set -euo pipefail
 cd "$(dirname "$0")/.."
+
+main_only=false
+case ${1:-} in
+  "") ;;
+  --main) main_only=true ;;
+  *) echo "usage: setup.sh [--main]" >&2; exit 2 ;;
+esac
 
 packages=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libopenmesh-dev libembree-dev libglm-dev libosmesa6-dev
-  libegl-dev libegl-mesa0  # render/'s EGL backend (headers; Mesa's EGL for the .egl tests)
-  libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev libgtest-dev libbenchmark-dev
+  libegl-dev            # render/'s EGL backend (headers)
+  libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
   libassimp-dev  # glTF 2.0 (.gltf, .glb) and 3DS import, meshes/src/read_assimp.cpp
-  libopenmpi-dev openmpi-bin  # mpirun prtr bake (optional CMake component PRTR_MPI) and its test
-  ffmpeg python3-matplotlib
+  ffmpeg                # the MP4 of prtr relight (and ffprobe for its test)
   libcpp-httplib-dev    # prtr view: the HTTP server
   libturbojpeg0-dev     # prtr view: JPEG frames
-  chromium              # prtr view's end-to-end test drives it headless (run, not linked)
   glmark2-data blender-data
   fonts-dejavu-core     # prtr overdraw's plots and the picture legends: DejaVu Sans via OpenImageIO
+)
+# The tests, benchmarks and optional parts: the main job needs none of them.
+$main_only || packages+=(
+  libgtest-dev libbenchmark-dev
+  libegl-mesa0          # Mesa's EGL for the .egl tests
+  libopenmpi-dev openmpi-bin  # mpirun prtr bake (optional CMake component PRTR_MPI) and its test
+  python3-matplotlib    # the plot of prtr overdraw (scripts/plot_overdraw.py)
+  chromium              # prtr view's end-to-end test drives it headless (run, not linked)
 )
 
 missing=()
@@ -53,6 +70,19 @@ fi
 
 build_type=${PRTR_BUILD_TYPE:-Release}
 build_start=$SECONDS
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
-cmake --build build -j "$(nproc)"
+if $main_only; then
+  # A tree the test command configured keeps its settings; a fresh one leaves out the tests
+  # and benchmarks, whose packages were not installed.
+  if [[ -f build/CMakeCache.txt ]]; then
+    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$build_type" >/dev/null
+  else
+    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
+      -DPRTR_BUILD_TESTS=OFF -DPRTR_BUILD_BENCH=OFF >/dev/null
+  fi
+  cmake --build build -j "$(nproc)" --target prtr
+else
+  cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE="$build_type" \
+    -DPRTR_BUILD_TESTS=ON -DPRTR_BUILD_BENCH=ON -DPRTR_MPI=ON >/dev/null
+  cmake --build build -j "$(nproc)"
+fi
 echo "setup: configured and built ./build ($build_type) in $((SECONDS - build_start)) s" >&2

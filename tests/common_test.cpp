@@ -3,11 +3,14 @@
 #include "common/enum_names.h"
 #include "common/hash.h"
 #include "common/output_path.h"
+#include "common/work_queue.h"
 
 #include "test_support.h"
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -137,3 +140,41 @@ TEST(EnumNames, NamesParseBackAndUnknownValuesSayUnknown) {
 }
 
 }  // namespace
+
+TEST(WorkQueue, RunsEveryTaskAndHoldsAtMostCapacityWaiting) {
+  std::atomic<int> done{0};
+  std::atomic<bool> release{false};
+  common::WorkQueue queue(2, 3);
+  // Two tasks block both workers; then three fit the backlog and a sixth must wait.
+  for (int i = 0; i < 2; ++i)
+    queue.submit([&] {
+      while (!release) std::this_thread::yield();
+      ++done;
+    });
+  // Both blockers have been taken by the workers once the backlog accepts three more.
+  for (int i = 0; i < 3; ++i) queue.submit([&] { ++done; });
+  std::atomic<bool> sixth_in{false};
+  std::thread producer([&] {
+    queue.submit([&] { ++done; });
+    sixth_in = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_FALSE(sixth_in) << "the backlog holds at most its capacity";
+  release = true;
+  producer.join();
+  queue.finish();
+  EXPECT_EQ(done, 6);
+}
+
+TEST(WorkQueue, FirstFailureReachesTheProducer) {
+  common::WorkQueue queue(1, 1);
+  queue.submit([] { throw std::runtime_error("disk full"); });
+  try {
+    queue.finish();
+    FAIL() << "finish() must rethrow";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "disk full");
+  }
+  EXPECT_THROW(queue.submit([] {}), std::runtime_error);
+  EXPECT_THROW(common::WorkQueue(0, 1), std::invalid_argument);
+}

@@ -6,6 +6,7 @@
 #include "animation.h"
 #include "bake_flags.h"
 #include "commands.h"
+#include "common/work_queue.h"
 #include "compress_flags.h"
 #include "contact_sheet.h"
 #include "cpca/compressed_file.h"
@@ -18,6 +19,7 @@
 #include "progress_bar.h"
 #include "prt/projection.h"
 #include "prt/sh_rotation.h"
+#include "render/gif.h"
 #include "render/gl_context.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -33,6 +35,7 @@
 #include <optional>
 #include <regex>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace prtr_app {
@@ -71,7 +74,7 @@ struct Options {
   ViewFlags view;
   CompressFlags compress;
   GlFlags gl;
-  int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0;
+  int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0, gif_width = 640;
   double degrees = 360.0;
   bool quiet = false, no_video = false;
 };
@@ -108,6 +111,10 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   cmd->add_option("--fps", o.fps, "Video frame rate")
       ->check(integer_in(1, 240))
+      ->capture_default_str();
+  cmd->add_option("--gif-width", o.gif_width,
+                  "Width of the animated GIF preview in pixels (0: the frames' own size)")
+      ->check(integer_in(0, 65535))
       ->capture_default_str();
   cmd->add_flag("--no-video", o.no_video, "Do not encode the MP4 (the GIF is always written)");
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
@@ -173,16 +180,64 @@ struct FrameTimes {
   double seconds = 0;  // with EXR/PNG output
 };
 
-// The sequence: EXR and PNG per frame, thumbnails for the contact sheet.
+// What the frames leave besides their files: contact-sheet thumbnails and GIF frames.
+struct Previews {
+  std::vector<render::Image> thumbnails;
+  std::vector<render::Rgb8Image> gif;  // every gif_stride-th frame
+  int gif_stride = 1;
+};
+
+// GIF frames are kept in memory until the palette of the whole sequence is known: past this
+// much, the GIF shows every k-th frame instead (a preview, not the sequence itself).
+constexpr double kGifBudgetBytes = 512.0 * 1024 * 1024;
+
+int gif_width(const Options& o, const render::Camera& camera) {
+  return o.gif_width == 0 ? camera.width : std::min(o.gif_width, camera.width);
+}
+
+Previews make_previews(const Options& o, const render::Camera& camera) {
+  Previews p;
+  const int width = gif_width(o, camera);
+  const double height = std::max(1.0, std::round(double(camera.height) * width / camera.width));
+  const double bytes = double(width) * height * 3.0 * double(o.frames);
+  p.gif_stride = int(std::ceil(std::max(1.0, bytes / kGifBudgetBytes)));
+  p.thumbnails.resize(std::size_t(o.frames));
+  p.gif.resize(std::size_t((o.frames + p.gif_stride - 1) / p.gif_stride));
+  return p;
+}
+
+// One frame's files and previews, on a writer thread: every frame writes its own files and
+// its own slots of `previews`, so writers share nothing.
+void write_frame(const Options& o, int f, const render::Image& image, int gif_w,
+                 Previews& previews) {
+  render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
+  render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
+  previews.thumbnails[std::size_t(f)] = downscale(image, o.thumbnail);
+  if (f % previews.gif_stride == 0) {
+    const render::Image small = gif_w == image.width ? image : downscale(image, gif_w);
+    previews.gif[std::size_t(f / previews.gif_stride)] = {
+        small.width, small.height, render::tone_map_rgb8(small, o.view.exposure)};
+  }
+}
+
+// Writers for the frames: image encoding (EXR's ZIP, PNG's deflate) costs several times
+// the render, so it overlaps with rendering on every core; four frames at most wait.
+int writer_threads() {
+  return std::clamp(int(std::thread::hardware_concurrency()), 2, 8);
+}
+
+// The sequence: EXR and PNG per frame, written while the next frames render.
 FrameTimes render_frames(const Options& o, render::Renderer& renderer, const render::Camera& camera,
-                         const prt::ShLighting& lighting, std::vector<render::Image>& thumbnails) {
+                         const prt::ShLighting& lighting, Previews& previews) {
   const Eigen::Vector3d axis = resolve_axis(o.view);
   const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
   for (int i = 0; i < 2; ++i) renderer.render(camera, lighting, identity);  // warm-up
   remove_old_frames(o.out);
   ProgressBar bar(o.quiet);
   FrameTimes times;
+  const int gif_w = gif_width(o, camera);
   const auto start = Clock::now();
+  common::WorkQueue writers(writer_threads(), 4);
   for (int f = 0; f < o.frames; ++f) {
     bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
     const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
@@ -190,20 +245,20 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
     times.frame_ms.push_back(t.total_ms);
     times.gl_ms.push_back(t.gl_ms);
     times.cpu_ms.push_back(t.cpu_ms);
-    const render::Image image = renderer.read_image();
-    render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
-    render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
-    thumbnails.push_back(downscale(image, o.thumbnail));
+    auto image = std::make_shared<const render::Image>(renderer.read_image());
+    writers.submit(
+        [&o, f, image, gif_w, &previews] { write_frame(o, f, *image, gif_w, previews); });
   }
+  writers.finish();
   bar.finish();
   times.seconds = seconds_since(start);
   return times;
 }
 
 // Always the GIF; the MP4 too unless --no-video. What to print on the "animation" line.
-std::string make_animations(const Options& o) {
+std::string make_animations(const Options& o, const Previews& previews) {
   const fs::path gif = fs::path(o.out) / "relight.gif";
-  write_gif(o.out, o.frames, o.fps, gif);
+  render::write_gif(gif, previews.gif, double(o.fps) / previews.gif_stride);
   if (o.no_video) return gif.string() + "; MP4 skipped (--no-video)";
   const fs::path mp4 = fs::path(o.out) / "relight.mp4";
   switch (write_mp4(o.out, o.fps, mp4)) {
@@ -263,11 +318,11 @@ Runner add_relight_command(CLI::App& app) {
     const prt::ShLighting lighting = prt::project(probe, set.order);
     render::GlContext context(gl);
     const auto renderer = make_renderer(o, mesh, set, probe, context);
-    std::vector<render::Image> thumbnails;
-    const FrameTimes times = render_frames(o, *renderer, camera, lighting, thumbnails);
+    Previews previews = make_previews(o, camera);
+    const FrameTimes times = render_frames(o, *renderer, camera, lighting, previews);
     const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
-    render::write_png(sheet, tile(thumbnails, o.columns), o.view.exposure);
-    const std::string video = make_animations(o);
+    render::write_png(sheet, tile(previews.thumbnails, o.columns), o.view.exposure);
+    const std::string video = make_animations(o, previews);
     print_summary(o, renderer->stats(), camera, times, video, sheet, seconds_since(start));
   };
 }

@@ -4,8 +4,11 @@
 #include "render/glm_eigen.h"
 #include "render/shader_source.h"
 
+#include <tbb/parallel_for.h>
 #include <glm/gtc/type_ptr.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -19,28 +22,93 @@ BackgroundPass::BackgroundPass(const probes::Probe* probe)
   set_probe(probe);
 }
 
-void BackgroundPass::set_probe(const probes::Probe* probe) {
-  glBindTexture(GL_TEXTURE_2D, texture_);
-  std::vector<float> texels;
-  int tw = 2, th = 1;
-  have_probe_ = false;
-  if (probe && probe->width() > 0) {
-    tw = probe->width();
-    th = probe->height();
-    texels.assign(std::size_t(tw) * th * 4, 1.f);
-    for (std::size_t i = 0; i < probe->texels().size(); ++i)
-      for (int c = 0; c < 3; ++c) texels[i * 4 + c] = probe->texels()[i][c];
-    have_probe_ = true;
-  } else {
-    texels.assign(8, 0.f);
+namespace {
+
+// The cubic B-spline of the probe's texels at the lat-long point of d (wrapping in u,
+// clamping in v, texel centres at half-integers): the look the background keeps.
+Eigen::Vector3f bspline(const probes::Probe& probe, const Eigen::Vector3d& d) {
+  const double theta = std::acos(std::clamp(d.y(), -1.0, 1.0));
+  double phi = std::atan2(-d.x(), d.z());
+  if (phi < 0) phi += 2 * std::numbers::pi;
+  const double px = phi / (2 * std::numbers::pi) * probe.width() - 0.5;
+  const double py = theta / std::numbers::pi * probe.height() - 0.5;
+  const double ix = std::floor(px), iy = std::floor(py);
+  auto weights = [](double f) {
+    const double w0 = (1 - f) * (1 - f) * (1 - f) / 6, w3 = f * f * f / 6;
+    const double w1 = (3 * f * f * f - 6 * f * f + 4) / 6;
+    return std::array<double, 4>{w0, w1, 1 - w0 - w1 - w3, w3};
+  };
+  const auto wx = weights(px - ix), wy = weights(py - iy);
+  const int w = probe.width(), h = probe.height();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int j = 0; j < 4; ++j) {
+    const int y = std::clamp(int(iy) - 1 + j, 0, h - 1);
+    for (int i = 0; i < 4; ++i) {
+      const int x = ((int(ix) - 1 + i) % w + w) % w;
+      sum += wx[std::size_t(i)] * wy[std::size_t(j)] * probe.texel(x, y).cast<double>();
+    }
   }
+  return sum.cast<float>();
+}
+
+// The direction through texel centre (s, t) in [-1, 1]^2 of cube face `face` (+X, -X, +Y,
+// -Y, +Z, -Z), inverting the face selection of the OpenGL specification (table 8.19 in 4.6).
+Eigen::Vector3d cube_direction(int face, double sc, double tc) {
+  switch (face) {
+    case 0:
+      return {1, -tc, -sc};
+    case 1:
+      return {-1, -tc, sc};
+    case 2:
+      return {sc, 1, tc};
+    case 3:
+      return {sc, -1, -tc};
+    case 4:
+      return {sc, -tc, 1};
+    default:
+      return {-sc, -tc, -1};
+  }
+}
+
+// Face size: 3 cube texels per lat-long texel at a face's centre (2 / size radians against
+// 2 pi / width), so that one bilinear tap between the B-spline's samples stays within 2 %
+// of the B-spline itself at the 99th percentile where a probe is most magnified
+// (tests/render_renderer_test.cpp, RealProbeBackgroundFollowsTheBspline: 1.5 texels gave
+// 7 %); at least 128, so small probes are sampled finely, and at most 2048.
+int cube_face_size(const probes::Probe& probe) {
+  const int size = int(std::ceil(3.0 * probe.width() / std::numbers::pi));
+  return std::clamp((size + 3) / 4 * 4, 128, 2048);
+}
+
+}  // namespace
+
+void BackgroundPass::set_probe(const probes::Probe* probe) {
+  have_probe_ = probe && probe->width() > 0;
+  if (!have_probe_) return;
+  // Resampled once per probe: per pixel, only the rotation changes, and one hardware cube
+  // tap costs a fraction of the lat-long B-spline's two arctangents and four bilinear taps.
+  const int size = cube_face_size(*probe);
+  std::vector<float> texels(std::size_t(size) * std::size_t(size) * 4);
+  glBindTexture(GL_TEXTURE_CUBE_MAP, texture_);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, tw, th, 0, GL_RGBA, GL_FLOAT, texels.data());
-  // Bilinear between texel centres, wrapping in u and clamping in v: Probe::lookup exactly.
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  for (int face = 0; face < 6; ++face) {
+    tbb::parallel_for(0, size, [&](int t) {
+      for (int s = 0; s < size; ++s) {
+        const double sc = 2.0 * (s + 0.5) / size - 1.0, tc = 2.0 * (t + 0.5) / size - 1.0;
+        const Eigen::Vector3f c = bspline(*probe, cube_direction(face, sc, tc).normalized());
+        float* out = &texels[(std::size_t(t) * std::size_t(size) + std::size_t(s)) * 4];
+        // Half floats end at 65504: clamp rather than store infinity.
+        for (int k = 0; k < 3; ++k) out[k] = std::clamp(c[k], -65504.f, 65504.f);
+        out[3] = 1.f;
+      }
+    });
+    glTexImage2D(GLenum(GL_TEXTURE_CUBE_MAP_POSITIVE_X + face), 0, GL_RGBA16F, size, size, 0,
+                 GL_RGBA, GL_FLOAT, texels.data());
+  }
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_CUBE_MAP, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  for (GLenum wrap : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R})
+    glTexParameteri(GL_TEXTURE_CUBE_MAP, wrap, GL_CLAMP_TO_EDGE);
   check_gl("Renderer: background");
 }
 
@@ -70,7 +138,8 @@ void BackgroundPass::draw(const Camera& camera, const Eigen::Matrix3d& rotation)
   glUniformMatrix3fv(program_.uniform("u_probe_from_world"), 1, GL_FALSE,
                      glm::value_ptr(probe_from_world));
   glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D, texture_);
+  glEnable(GL_TEXTURE_CUBE_MAP_SEAMLESS);  // filter across face edges: no seams
+  glBindTexture(GL_TEXTURE_CUBE_MAP, texture_);
   glUniform1i(program_.uniform("u_probe"), 0);
   glDrawArrays(GL_TRIANGLES, 0, 3);
 }

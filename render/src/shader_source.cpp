@@ -226,65 +226,16 @@ std::string background_vertex_shader() {
          "}\n";
 }
 
-float atan2_approx(float y, float x) {
-  const float pi = std::numbers::pi_v<float>;
-  const float ax = std::abs(x), ay = std::abs(y);
-  const float a = std::min(ax, ay) / std::max(std::max(ax, ay), 1e-30f);
-  const float s = a * a;
-  float r = kAtanCoefficients[4];
-  for (int k = 3; k >= 0; --k) r = r * s + kAtanCoefficients[k];
-  r *= a;
-  if (ay > ax) r = 0.5f * pi - r;
-  if (x < 0.f) r = pi - r;
-  return y < 0.f ? -r : r;
-}
-
 std::string background_fragment_shader() {
-  // A polynomial atan2 (atan2_approx, the same operations): llvmpipe's acos/atan made this
-  // pass cost more than the mesh.
-  std::string poly = literal(kAtanCoefficients[4]);
-  for (int k = 3; k >= 0; --k) poly = "(" + poly + ") * s + " + literal(kAtanCoefficients[k]);
+  // The probe arrives resampled into a cube map (background_pass.cpp): one seamless,
+  // hardware-filtered tap in the rotated direction.
   return std::string(kHeader) +
          "in vec3 v_direction;\n"
          "uniform mat3 u_probe_from_world;\n"
-         "uniform sampler2D u_probe;\n"
+         "uniform samplerCube u_probe;\n"
          "layout(location = 0) out vec4 o_colour;\n"
-         "const float kPi = 3.14159265358979;\n"
-         "float atan2_fast(float y, float x) {\n"
-         "  float ax = abs(x), ay = abs(y);\n"
-         "  float a = min(ax, ay) / max(max(ax, ay), 1e-30);\n"
-         "  float s = a * a;\n"
-         "  float r = (" +
-         poly +
-         ") * a;\n"
-         "  if (ay > ax) r = 0.5 * kPi - r;\n"
-         "  if (x < 0.0) r = kPi - r;\n"
-         "  return y < 0.0 ? -r : r;\n"
-         "}\n"
-         // Cubic B-spline from four bilinear taps: magnified ~10x, bilinear HDR texels show
-         // as squares; the B-spline is C2 and never negative (no ringing around the sun).
-         "vec3 probe_bspline(vec2 uv) {\n"
-         "  vec2 size = vec2(textureSize(u_probe, 0));\n"
-         "  vec2 p = uv * size - 0.5;\n"
-         "  vec2 i = floor(p), f = p - i;\n"
-         "  vec2 w0 = (1.0 - f) * (1.0 - f) * (1.0 - f) / 6.0;\n"
-         "  vec2 w1 = (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0;\n"
-         "  vec2 w3 = f * f * f / 6.0;\n"
-         "  vec2 w2 = 1.0 - w0 - w1 - w3;\n"
-         "  vec2 g0 = w0 + w1, g1 = w2 + w3;\n"
-         "  vec2 t0 = (i - 0.5 + w1 / g0) / size, t1 = (i + 1.5 + w3 / g1) / size;\n"
-         "  return g0.y * (g0.x * texture(u_probe, t0).rgb + g1.x * texture(u_probe, vec2(t1.x, "
-         "t0.y)).rgb)\n"
-         "       + g1.y * (g0.x * texture(u_probe, vec2(t0.x, t1.y)).rgb + g1.x * texture(u_probe, "
-         "t1).rgb);\n"
-         "}\n"
          "void main() {\n"
-         "  vec3 d = u_probe_from_world * v_direction;\n"
-         "  // probes/probe.h: direction(u, v) = (-sin t sin p, cos t, sin t cos p).\n"
-         "  float theta = atan2_fast(length(d.xz), d.y);\n"
-         "  float phi = atan2_fast(-d.x, d.z);\n"
-         "  if (phi < 0.0) phi += 2.0 * kPi;\n"
-         "  o_colour = vec4(probe_bspline(vec2(phi / (2.0 * kPi), theta / kPi)), 0.0);\n"
+         "  o_colour = vec4(texture(u_probe, u_probe_from_world * v_direction).rgb, 0.0);\n"
          "}\n";
 }
 

@@ -55,18 +55,11 @@ std::string radiance_fragment_shader();  // vec4(v_radiance, 1)
 std::string coverage_fragment_shader();  // vec4(0, 0, 0, 1): alpha = coverage
 std::string constant_fragment_shader();  // uniform u_colour, alpha 1
 
-// Full-screen triangle at depth 1 and the lat-long probe lookup (probes/probe.h
-// convention); alpha 0 (background is not coverage). Solid colours are the clear colour.
+// Full-screen triangle at depth 1 and one lookup of the probe, resampled into a cube map
+// (render/src/background_pass.cpp); alpha 0 (background is not coverage). Solid colours
+// are the clear colour.
 std::string background_vertex_shader();
 std::string background_fragment_shader();
 
-// The background shader's atan2, mirrored in C++ with the same float operations so its error
-// can be swept on the CPU: atan on [0, 1] by the odd degree-9 polynomial of Abramowitz &
-// Stegun 4.4.49, then octant folding. Measured over 200,000 angles
-// (tests/render_shader_test.cpp): 1.17e-5 rad, under 1/500 of a texel of a 1024-wide probe.
-inline constexpr float kAtanCoefficients[5] = {0.9998660f, -0.3302995f, 0.1801410f, -0.0851330f,
-                                               0.0208351f};
-inline constexpr double kAtan2MaxError = 1.2e-5;
-float atan2_approx(float y, float x);
 
 }  // namespace render
