@@ -185,10 +185,14 @@ std::string uncompressed_vertex_shader(int order, bool glossy) {
 }
 
 std::string passthrough_vertex_shader() {
-  return std::string(kHeader) + kPositionDecl +
-         "layout(location = 15) in vec3 a_radiance;\n"
-         "out vec3 v_radiance;\n\nvoid main() {\n" +
-         kPositionStatement + "  v_radiance = a_radiance;\n}\n";
+  // Appended piece by piece: GCC 12 misreads this sum of literals as an out-of-bounds memcpy
+  // (-Warray-bounds false positive) once the precompiled <string> is in use.
+  std::string s(kHeader);
+  s += kPositionDecl;
+  s += "layout(location = 15) in vec3 a_radiance;\nout vec3 v_radiance;\n\nvoid main() {\n";
+  s += kPositionStatement;
+  s += "  v_radiance = a_radiance;\n}\n";
+  return s;
 }
 
 std::string position_vertex_shader() {
