@@ -13,6 +13,7 @@
 #include "render/camera.h"
 #include "render/false_colour.h"
 #include "render/gl_context.h"
+#include "render/pass_capacity.h"
 #include "render/renderer.h"
 
 #include <algorithm>
@@ -417,7 +418,8 @@ void measure_compression(const Scene& s, const Compression& c, OverdrawReport& r
   for (const std::string& budget_name : plan.budgets) {
     if (designed && budget_name != c.designed_budget) continue;
     const int budget = budget_registers(s, budget_name, cost);
-    const int per_pass = std::min(c.k, budget / cost);
+    const int per_pass =
+        std::min(c.k, render::pass_capacity(c.set, budget, s.context_budget).clusters_per_pass);
     if (designed && per_pass != c.designed_per_pass)
       throw std::logic_error(c.label() + ": designed for " + std::to_string(c.designed_per_pass) +
                              " clusters per pass, the budget holds " + std::to_string(per_pass));
@@ -462,11 +464,15 @@ struct Rows {
   Progress progress;
 };
 
-// The registers one cluster of this bake will cost the renderer (render::constant_layout),
-// known before compressing: a pass-designing method needs its clusters per pass up front.
+// The layout (and so the registers) one cluster of this bake will cost the renderer, known
+// before compressing: a pass-designing method needs its clusters per pass up front.
+render::ConstantLayout expected_layout(const Scene& s) {
+  return render::constant_layout(s.transfer.order, s.transfer.columns() > 1,
+                                 s.plan.compress.components);
+}
+
 int expected_cost(const Scene& s) {
-  const int rows = s.transfer.columns() > 1 ? s.transfer.order * s.transfer.order : 1;
-  return ((s.plan.compress.components + 1) * 3 * rows + 3) / 4;
+  return expected_layout(s).registers_per_cluster();
 }
 
 // One compression (K x method, and the budget a pass-designing method designs for) and its
@@ -569,7 +575,10 @@ OverdrawReport run_overdraw(const OverdrawPlan& plan) {
       }
       const int cost = expected_cost(s);
       for (const std::string& budget : plan.budgets) {
-        const int per_pass = std::min(k, budget_registers(s, budget, cost) / cost);
+        const int per_pass = std::min(
+            k, render::pass_capacity(expected_layout(s), s.transfer.order, plan.compress.components,
+                                     budget_registers(s, budget, cost), s.context_budget)
+                   .clusters_per_pass);
         measure_method(rows, k, method, per_pass, budget,
                        method_name == plan.methods.front() && budget == plan.budgets.front());
       }

@@ -30,13 +30,17 @@ void basis_at(int order, bool glossy, const Eigen::Vector3d& local, float* y) {
 
 }  // namespace
 
-ConstantLayout constant_layout(const cpca::CompressedSet& set) {
+ConstantLayout constant_layout(int order, bool glossy, int components) {
   ConstantLayout l;
-  l.glossy = set.glossy();
-  l.order = l.glossy ? set.order : 1;
-  l.rows = rows_of(set.order, l.glossy);
-  l.terms = set.component_count + 1;
+  l.glossy = glossy;
+  l.order = glossy ? order : 1;
+  l.rows = rows_of(order, glossy);
+  l.terms = components + 1;
   return l;
+}
+
+ConstantLayout constant_layout(const cpca::CompressedSet& set) {
+  return constant_layout(set.order, set.glossy(), set.component_count);
 }
 
 ShadingConstants::ShadingConstants(const cpca::CompressedSet& set)

@@ -13,9 +13,9 @@
 
 namespace render {
 
-// Empty for "order" (the renderer's own default) or when not even one cluster fits (the
-// renderer then reports the budget error). std::invalid_argument for an unknown strategy
-// name.
+// Empty for "order" (the renderer's own default). std::invalid_argument for an unknown
+// strategy name, and for a budget or clusters-per-pass count that does not fit (the rule of
+// render/pass_capacity.h, the renderer's own).
 std::optional<cpca::SuperClusters> group_for_renderer(const meshes::Mesh& mesh,
                                                       const cpca::CompressedSet& set,
                                                       const render::GlContext& context,

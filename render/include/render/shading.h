@@ -48,6 +48,9 @@ struct ConstantLayout {
 };
 
 ConstantLayout constant_layout(const cpca::CompressedSet& set);
+// The same for a set not compressed yet: SH `order`, glossy (transfer matrices) or diffuse,
+// `components` PCs per cluster.
+ConstantLayout constant_layout(int order, bool glossy, int components);
 
 // Packs a compressed set's matrices once, then computes every frame's constants.
 class ShadingConstants {
