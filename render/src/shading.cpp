@@ -192,22 +192,4 @@ void exit_vectors(const prt::TransferSet& transfer,
       });
 }
 
-void shade_exit_vectors(const std::vector<float>& exit, int order, bool glossy,
-                        const meshes::Mesh& mesh, const Eigen::Vector3d& eye,
-                        std::vector<Rgb>& radiance) {
-  const int rows = rows_of(order, glossy);
-  const std::size_t vertex_count = mesh.vertex_count();
-  radiance.resize(vertex_count);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertex_count, 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Eigen::VectorXf y(rows);
-                      for (std::size_t p = range.begin(); p < range.end(); ++p) {
-                        const Eigen::Vector3d local = local_view(mesh, p, eye);
-                        basis_at(order, glossy, local, y.data());
-                        radiance[p] =
-                            Eigen::Map<const RowMatrixXf>(exit.data() + p * 3 * rows, 3, rows) * y;
-                      }
-                    });
-}
-
 }  // namespace render

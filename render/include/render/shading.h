@@ -96,9 +96,4 @@ std::vector<Rgb> reference_vertex_radiance(const cpca::CompressedSet& set, const
 void exit_vectors(const prt::TransferSet& transfer,
                   const Eigen::Ref<const prt::ShLighting>& lighting, std::vector<float>& out);
 
-// Radiance from exit vectors in the layout above (the CPU side of the uncompressed path).
-void shade_exit_vectors(const std::vector<float>& exit, int order, bool glossy,
-                        const meshes::Mesh& mesh, const Eigen::Vector3d& eye,
-                        std::vector<Rgb>& radiance);
-
 }  // namespace render
