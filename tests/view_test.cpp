@@ -126,6 +126,36 @@ TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
   }
 }
 
+TEST(ViewRequest, RawQueriesAreSplitStrictly) {
+  const QueryParams q = viewer::parse_query("w=480&mode=cpu&client=a%2Db&probe=1+");
+  const QueryParams expected{{"w", "480"}, {"mode", "cpu"}, {"client", "a-b"}, {"probe", "1 "}};
+  EXPECT_EQ(q, expected);
+  EXPECT_TRUE(viewer::parse_query("").empty());
+  // Each malformed query is refused with a one-line reason naming what is wrong.
+  const std::pair<std::string, std::string> bad[] = {
+      {"w=abc=480", "'=' in its value"},
+      {"mode=bogus=cpu", "'=' in its value"},
+      {"w=960;h=710", "';'"},
+      {"w=480&w=480", "repeated"},
+      {"client=a&client=a", "repeated"},
+      {"w", "no value"},
+      {"w=1&&h=2", "empty parameter"},
+      {"w=1&", "empty parameter"},
+      {"w=%zz", "%-escape"},
+      {"w=%4", "%-escape"},
+  };
+  for (const auto& [query, reason] : bad) {
+    try {
+      viewer::parse_query(query);
+      ADD_FAILURE() << "accepted " << query;
+    } catch (const RequestError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(reason), std::string::npos) << query << ": " << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
 TEST(ViewRequest, UncompressedIsAcceptedWhenTheTransferIsAtHand) {
   ViewLimits l = limits();
   l.uncompressed = true;

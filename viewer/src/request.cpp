@@ -139,6 +139,58 @@ const char* overlay_name(Overlay overlay) {
   return common::enum_name<Overlay>(kOverlayNames, overlay);
 }
 
+namespace {
+
+int hex_digit(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+std::string percent_decode(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '+') {
+      out += ' ';
+    } else if (text[i] != '%') {
+      out += text[i];
+    } else {
+      const int hi = i + 2 < text.size() ? hex_digit(text[i + 1]) : -1;
+      const int lo = hi >= 0 ? hex_digit(text[i + 2]) : -1;
+      if (lo < 0) throw RequestError("bad %-escape in " + quoted(text));
+      out += char(hi * 16 + lo);
+      i += 2;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+QueryParams parse_query(const std::string& raw) {
+  QueryParams params;
+  if (raw.empty()) return params;
+  if (raw.find(';') != std::string::npos)
+    throw RequestError("';' is not a parameter separator; use '&'");
+  std::size_t begin = 0;
+  while (begin <= raw.size()) {
+    const std::size_t end = std::min(raw.find('&', begin), raw.size());
+    const std::string pair = raw.substr(begin, end - begin);
+    if (pair.empty()) throw RequestError("empty parameter (a stray '&')");
+    const std::size_t eq = pair.find('=');
+    if (eq == std::string::npos)
+      throw RequestError("parameter " + quoted(percent_decode(pair)) + " has no value");
+    const std::string key = percent_decode(pair.substr(0, eq));
+    if (pair.find('=', eq + 1) != std::string::npos)
+      throw RequestError("parameter " + quoted(key) + ": '=' in its value");
+    if (params.count(key)) throw RequestError("parameter " + quoted(key) + " repeated");
+    params.emplace(key, percent_decode(pair.substr(eq + 1)));
+    begin = end + 1;
+  }
+  return params;
+}
+
 std::vector<std::string> view_parameter_names() {
   std::vector<std::string> names;
   for (const auto& [name, setter] : setters()) names.push_back(name);

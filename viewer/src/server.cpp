@@ -6,6 +6,7 @@
 
 #include <httplib.h>
 
+#include <sys/socket.h>
 #include <unistd.h>
 #include <atomic>
 #include <cerrno>
@@ -91,8 +92,11 @@ void handle_frame(FrameQueue& queue, const ServedInfo& served, const httplib::Re
                   httplib::Response& res) {
   ViewState state;
   try {
-    state = parse_view_request(QueryParams(req.params.begin(), req.params.end()), served.limits,
-                               served.defaults);
+    // The raw query, not httplib's lenient parse (which keeps `w=abc=480` as w=480 and splits
+    // on ';').
+    const std::size_t mark = req.target.find('?');
+    const std::string raw = mark == std::string::npos ? "" : req.target.substr(mark + 1);
+    state = parse_view_request(parse_query(raw), served.limits, served.defaults);
   } catch (const RequestError& e) {
     res.status = 400;
     res.set_content(std::string(e.what()) + "\n", "text/plain");
@@ -106,10 +110,29 @@ void handle_frame(FrameQueue& queue, const ServedInfo& served, const httplib::Re
   }
 }
 
+// A web page the user visits may reach 127.0.0.1 through DNS rebinding: its requests carry
+// its own host name. Only the address the server listens on and localhost are served.
+bool allowed_host(const std::string& host_header, const ServerOptions& options, int port) {
+  const std::string port_text = std::to_string(port);
+  const std::size_t colon = host_header.rfind(':');
+  if (colon == std::string::npos || host_header.compare(colon + 1, std::string::npos, port_text))
+    return false;
+  const std::string name = host_header.substr(0, colon);
+  return name == options.host || name == "localhost";
+}
+
+void refuse(httplib::Response& res, int status, const std::string& why) {
+  res.status = status;
+  res.set_content(why + "\n", "text/plain");
+}
+
 void add_routes(httplib::Server& server, FrameQueue& queue, const ServedInfo& served) {
   server.Get("/", [](const httplib::Request&, httplib::Response& res) {
     res.set_content(view_page_html(), "text/html; charset=utf-8");
   });
+  // Browsers ask for it on every page load; no icon, and no 404 in their console.
+  server.Get("/favicon.ico",
+             [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
   const std::string info = dump_json(served.info);
   server.Get("/api/info", [info](const httplib::Request&, httplib::Response& res) {
     res.set_content(info, "application/json");
@@ -117,6 +140,16 @@ void add_routes(httplib::Server& server, FrameQueue& queue, const ServedInfo& se
   server.Get("/frame", [&queue, &served](const httplib::Request& req, httplib::Response& res) {
     handle_frame(queue, served, req, res);
   });
+  // Every path is read-only: other methods are 405 (httplib would answer 404).
+  const auto not_allowed = [](const httplib::Request& req, httplib::Response& res) {
+    res.set_header("Allow", "GET, HEAD");
+    refuse(res, 405, req.method + " is not allowed; prtr view answers GET");
+  };
+  server.Post(".*", not_allowed);
+  server.Put(".*", not_allowed);
+  server.Patch(".*", not_allowed);
+  server.Delete(".*", not_allowed);
+  server.Options(".*", not_allowed);
   server.set_error_handler([](const httplib::Request&, httplib::Response& res) {
     if (res.body.empty())
       res.set_content(res.status == 404 ? "not found\n" : "bad request\n", "text/plain");
@@ -198,8 +231,23 @@ void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions&
   // Headers and body go out in separate writes: with Nagle's algorithm the body waits for
   // the client's delayed ACK (~40 ms on Linux), longer than a small frame takes to render.
   server.set_tcp_nodelay(true);
+  // SO_REUSEADDR only (a restart need not wait out TIME_WAIT). httplib's default adds
+  // SO_REUSEPORT, with which a second viewer binds the same port and takes half the requests.
+  server.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   add_routes(server, queue, served);
   const int port = bind(server, options);
+  server.set_pre_routing_handler([&options, port](const httplib::Request& req,
+                                                  httplib::Response& res) {
+    if (allowed_host(req.get_header_value("Host"), options, port))
+      return httplib::Server::HandlerResponse::Unhandled;
+    refuse(res, 421,
+           "Host '" + req.get_header_value("Host") + "' is not this server; use " + options.host +
+               ":" + std::to_string(port) + " or localhost:" + std::to_string(port));
+    return httplib::Server::HandlerResponse::Handled;
+  });
   StopSignals signals;
   std::printf("prtr view: http://%s:%d/\n", options.host.c_str(), port);
   std::fflush(stdout);

@@ -52,6 +52,12 @@ class RequestError : public std::invalid_argument {
 
 using QueryParams = std::multimap<std::string, std::string>;
 
+// The parameters of a raw query string (after '?', still percent-encoded), strictly:
+// '&'-separated key=value pairs, each key once. A ';' separator, an empty pair, a key without
+// '=', a second '=' in a pair (trailing garbage), a repeated key or a bad %-escape is a
+// RequestError with a one-line reason. '+' is a space, as browsers encode it.
+QueryParams parse_query(const std::string& raw);
+
 // The state `params` describe (unnamed fields keep `defaults`); throws RequestError.
 ViewState parse_view_request(const QueryParams& params, const ViewLimits& limits,
                              const ViewState& defaults = {});
