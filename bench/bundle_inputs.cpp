@@ -11,7 +11,7 @@
 #include "meshes/load.h"
 #include "meshes/subdivide.h"
 #include "meshes/write_ply.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <chrono>
 #include <cstdio>
@@ -45,12 +45,12 @@ int main(int argc, char** argv) {
       prt::BakeOptions bake;
       bake.samples = samples;
       bake.bounces = 0;
-      const prt::TransferSet transfer = prtr_app::run_bake(mesh, ply.string(), bake, true);
+      const prt::TransferSet transfer = pipeline::run_bake(mesh, ply.string(), bake, {});
       cpca::CompressOptions compress;
       compress.clusters = 256;
       compress.components = 8;
       cpca::write_compressed(out / (name + ".prtc"),
-                             prtr_app::run_compress(transfer, mesh, ply.string(), compress, true));
+                             pipeline::run_compress(transfer, mesh, ply.string(), compress, {}));
       std::printf("bundle_inputs: %s, %zu vertices, %.1f s\n", name.c_str(), mesh.vertex_count(),
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       std::fflush(stdout);

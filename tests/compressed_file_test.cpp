@@ -140,16 +140,8 @@ void expect_same(const CompressedSet& a, const CompressedSet& b) {
 // Runs read_compressed and returns the error message, failing unless it names the file and
 // contains `expected`.
 std::string read_error(const fs::path& p, const std::string& expected) {
-  try {
-    cpca::read_compressed(p);
-  } catch (const cpca::CompressedFileError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(p.string()), std::string::npos) << "message does not name the file: " << msg;
-    EXPECT_NE(msg.find(expected), std::string::npos) << "expected '" << expected << "' in: " << msg;
-    return msg;
-  }
-  ADD_FAILURE() << p << ": expected a CompressedFileError mentioning '" << expected << "'";
-  return {};
+  return test_support::error_of<cpca::CompressedFileError>(
+      p, [](const fs::path& q) { cpca::read_compressed(q); }, expected);
 }
 
 // --- Round trips ---------------------------------------------------------------------------
@@ -262,14 +254,14 @@ TEST(CompressedFile, EachCorruptionHasItsOwnMessage) {
   const std::size_t off = payload_offset(set);
   const std::size_t weights = off + 4 * 10, means = weights + 4 * 30, bases = means + 4 * 64;
   const std::size_t size = bases + 4 * 4 * 3 * 16;
-  std::map<std::string, std::string> messages;
+  test_support::DamageMessages messages;
   const auto fresh = [&](const std::string& name) {
     const fs::path p = scratch("damaged_" + name + ".prtc");
     cpca::write_compressed(p, set);
     return p;
   };
   const auto check = [&](const std::string& name, const fs::path& p, const std::string& expected) {
-    messages[name] = read_error(p, expected);
+    messages.record(name, read_error(p, expected));
   };
   // A header field set to `value` with the header checksum recomputed.
   const auto field = [&](const std::string& name, std::size_t offset, std::uint32_t value,
@@ -408,14 +400,7 @@ TEST(CompressedFile, EachCorruptionHasItsOwnMessage) {
     check("directory", p, "is a directory");
   }
 
-  // No two kinds of damage share a message (compared with the file name taken out).
-  std::set<std::string> problems;
-  for (const auto& [name, msg] : messages) {
-    const std::size_t colon = msg.find(": ");
-    ASSERT_NE(colon, std::string::npos) << name << ": " << msg;
-    EXPECT_TRUE(problems.insert(msg.substr(colon + 2)).second) << name << " repeats: " << msg;
-  }
-  EXPECT_EQ(messages.size(), 34u);
+  messages.expect_distinct(34);
 }
 
 // --- Writing ---------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include "cpca/joint_search.h"
 
 #include "cpca/cluster_pca.h"
+#include "cpca/compress.h"
 
 #include "cpca/supercluster_strategy.h"
 #include "cpca_test_support.h"

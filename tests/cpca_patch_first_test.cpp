@@ -4,6 +4,7 @@
 // a brute-force count over the patches gives.
 #include "cpca/patch_first.h"
 
+#include "cpca/compress.h"
 #include "cpca_test_support.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,8 @@
 // The overdraw benchmark's statistics and plots: quartiles and the least-squares line against
 // hand-computed answers, and the plots decoded from their PNG files with every marker found
 // where the layout documented in overdraw_plot.h puts the data (the mapping recomputed here).
-#include "overdraw_plot.h"
-#include "overdraw_stats.h"
+#include "overdraw/plot.h"
+#include "overdraw/stats.h"
 
 #include <gtest/gtest.h>
 
@@ -15,21 +15,21 @@
 
 namespace {
 
-using prtr_app::fit_line;
-using prtr_app::LineFit;
-using prtr_app::OverdrawReport;
-using prtr_app::OverdrawRow;
+using overdraw::fit_line;
+using overdraw::LineFit;
+using overdraw::OverdrawReport;
+using overdraw::OverdrawRow;
 
 TEST(OverdrawStats, QuartilesInterpolateBetweenOrderStatistics) {
-  const prtr_app::Spread s = prtr_app::spread({4, 1, 3, 2});  // unsorted on purpose
+  const overdraw::Spread s = overdraw::spread({4, 1, 3, 2});  // unsorted on purpose
   EXPECT_DOUBLE_EQ(s.median, 2.5);
   EXPECT_DOUBLE_EQ(s.q1, 1.75);  // h = 3 / 4: 1 + 0.75 (2 - 1)
   EXPECT_DOUBLE_EQ(s.q3, 3.25);
   EXPECT_DOUBLE_EQ(s.iqr(), 1.5);
-  const prtr_app::Spread one = prtr_app::spread({7});
+  const overdraw::Spread one = overdraw::spread({7});
   EXPECT_EQ(one.median, 7);
   EXPECT_EQ(one.iqr(), 0);
-  EXPECT_EQ(prtr_app::spread({}).median, 0);
+  EXPECT_EQ(overdraw::spread({}).median, 0);
 }
 
 TEST(OverdrawStats, AnExactLineIsRecoveredWithRSquaredOne) {
@@ -132,7 +132,7 @@ TEST(OverdrawPlot, ParetoMarkersAndTheThesisLineLandWhereTheDataSays) {
   report.rows.push_back(row(64, "original", 1.40, 3.4e-3, 47));
   report.rows.back().budget = "default";  // another budget: not in this plot
   const Decoded d = write_and_decode(
-      prtr_app::pareto_plot(report, "thesis", prtr_app::thesis_best_overdraw()), "pareto.png");
+      overdraw::pareto_plot(report, "thesis", overdraw::thesis_best_overdraw()), "pareto.png");
   ASSERT_EQ(d.width, 1120);  // two panels side by side
   ASSERT_EQ(d.height, 34 + 420);
 
@@ -151,18 +151,18 @@ TEST(OverdrawPlot, ParetoMarkersAndTheThesisLineLandWhereTheDataSays) {
   EXPECT_EQ(d.at(k128.px(1.33), k128.py(1.7e-3)), kFirstMethod);
   EXPECT_EQ(d.at(k128.px(1.24), k128.py(1.5e-3)), kSecondMethod);
   EXPECT_EQ(d.at(k128.px(1.286), k128.top() + 2), (std::array<int, 3>{120, 120, 120}));
-  EXPECT_THROW(prtr_app::pareto_plot(report, "none", {}), std::invalid_argument);
+  EXPECT_THROW(overdraw::pareto_plot(report, "none", {}), std::invalid_argument);
 }
 
 TEST(OverdrawPlot, TimingMarkersSitOnTheirMediansBesideTheFittedLine) {
   OverdrawReport report;
   report.rows = {row(64, "original", 1.0, 1e-3, 40), row(64, "both", 1.5, 1e-3, 60),
                  row(64, "both", 2.0, 1e-3, 80)};
-  prtr_app::fit_timings(report);
+  overdraw::fit_timings(report);
   EXPECT_NEAR(report.gl_fit.slope, 40, 1e-9);
   EXPECT_NEAR(report.gl_fit.r2, 1, 1e-12);
   EXPECT_NEAR(report.process_cpu_fit.slope, 80, 1e-9);
-  const Decoded d = write_and_decode(prtr_app::timing_plot(report), "timing.png");
+  const Decoded d = write_and_decode(overdraw::timing_plot(report), "timing.png");
   ASSERT_EQ(d.width, 1120);
   ASSERT_EQ(d.height, 34 + 2 * 420);  // three panels: two rows of the 2-column grid
   // GL panel: y spans the medians and their quartiles (39 .. 81).

@@ -5,7 +5,7 @@
 #include "cpca/supercluster.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/procedural.h"
-#include "overdraw_report.h"
+#include "overdraw/report.h"
 #include "render/false_colour.h"
 #include "render/gl_context.h"
 #include "render/renderer.h"
@@ -67,7 +67,8 @@ TEST(OverdrawRenderer, MeasuredTrianglesEqualTheCostModelForEveryStrategyAndBudg
   const cpca::CompressedSet set = patch_set(mesh, 6, 4);  // 24 clusters
   const std::vector<cpca::TriangleIndices> triangles = triangles_of(mesh);
   const int cost = render::constant_layout(set).registers_per_cluster();
-  ASSERT_EQ(cost, cpca::registers_per_cluster(set.order, set.component_count));
+  // (N + 1) RGB radiance vectors of n = order^2 floats each, packed into vec4s.
+  ASSERT_EQ(cost, ((set.component_count + 1) * set.order * set.order * 3 + 3) / 4);
   render::Camera camera = render::frame_sphere(Eigen::Vector3d::Zero(), 1.0, 64, 48);
 
   int configurations = 0;
@@ -260,13 +261,13 @@ TEST(FalseColour, PngKeepsColoursByteForByte) {
 // --- Report ----------------------------------------------------------------------------------
 
 TEST(OverdrawReport, TablesCsvAndJsonCarryEveryRow) {
-  prtr_app::OverdrawReport r;
+  overdraw::OverdrawReport r;
   r.mesh = "m.obj";
   r.triangles = 100;
   for (int k : {64, 128})
     for (const char* method : {"original", "both"})
       for (const char* strategy : {"order", "ils"}) {
-        prtr_app::OverdrawRow row;
+        overdraw::OverdrawRow row;
         row.clusters = k;
         row.method = method;
         row.budget = "thesis";
@@ -276,12 +277,12 @@ TEST(OverdrawReport, TablesCsvAndJsonCarryEveryRow) {
         r.rows.push_back(row);
       }
   r.modes.push_back({64, "singlepass", std::nan(""), 1.0, 0.0, 0.0});
-  const std::string md = prtr_app::markdown(r);
+  const std::string md = overdraw::markdown(r);
   EXPECT_NE(md.find("### 64 clusters, thesis budget"), std::string::npos);
   EXPECT_NE(md.find("| original | ils | 3 m 53 s | 1.125000 |"), std::string::npos) << md;
-  const std::string table = prtr_app::csv(r);
+  const std::string table = overdraw::csv(r);
   EXPECT_EQ(std::count(table.begin(), table.end(), '\n'), 1 + 8);
-  const nlohmann::json js = nlohmann::json::parse(prtr_app::json(r));
+  const nlohmann::json js = nlohmann::json::parse(overdraw::json(r));
   ASSERT_EQ(js.at("rows").size(), 8u);
   // Row 5 is K = 128, original, ils: 1 + 128/512 exactly.
   EXPECT_EQ(js.at("rows").at(5).at("average_overdraw").get<double>(), 1.25);
@@ -289,7 +290,7 @@ TEST(OverdrawReport, TablesCsvAndJsonCarryEveryRow) {
   EXPECT_EQ(js.at("rows").at(5).at("strategy").get<std::string>(), "ils");
   // Not a number has no JSON spelling: it is written as null, as before the library.
   EXPECT_TRUE(js.at("modes").at(0).at("fps").is_null());
-  EXPECT_EQ(prtr_app::format_duration(12.44), "12.4 s");
+  EXPECT_EQ(overdraw::format_duration(12.44), "12.4 s");
 }
 
 // Every string field carries a file name or a GL string the user does not control: quotes,
@@ -299,14 +300,14 @@ TEST(OverdrawReport, JsonSurvivesHostileStrings) {
                                   "a\"b\\c\n\t\x01"
                                   "d") +
                               "\xff\xfe" + "\xc3(" + "\xe9t\xc3\xa9";
-  prtr_app::OverdrawReport r;
+  overdraw::OverdrawReport r;
   r.mesh = r.probe = r.transfer = r.bake = r.gl_renderer = hostile;
-  prtr_app::OverdrawRow row;
+  overdraw::OverdrawRow row;
   row.method = row.budget = row.strategy = hostile;
   r.rows.push_back(row);
   r.modes.push_back({1, hostile, 1.0, 1.0, 0.0, 0.0});
   nlohmann::json js;
-  ASSERT_NO_THROW(js = nlohmann::json::parse(prtr_app::json(r)));
+  ASSERT_NO_THROW(js = nlohmann::json::parse(overdraw::json(r)));
   // The valid parts survive byte for byte; each invalid byte becomes U+FFFD.
   const std::string replaced =
       "a\"b\\c\n\t\x01"

@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 
 #include <cmath>
+#include <string>
 
 namespace {
 
@@ -59,8 +60,12 @@ TEST_P(PowerIterationShapes, MatchesEigenSolver) {
   EXPECT_NEAR(residual.squaredNorm(), rest, 1e-8 * f.squaredNorm());
 }
 
+// Named "40x120" etc., so CTest lists the shape rather than the parameter's bytes.
 INSTANTIATE_TEST_SUITE_P(BothShapes, PowerIterationShapes,
-                         ::testing::Values(Shape{40, 120}, Shape{300, 60}, Shape{60, 60}));
+                         ::testing::Values(Shape{40, 120}, Shape{300, 60}, Shape{60, 60}),
+                         [](const ::testing::TestParamInfo<Shape>& p) {
+                           return std::to_string(p.param.m) + "x" + std::to_string(p.param.n);
+                         });
 
 TEST(PowerIteration, RankDeficientDataGivesZeroComponents) {
   Eigen::VectorXd s(3);

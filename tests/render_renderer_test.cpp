@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <numbers>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
@@ -211,10 +212,16 @@ TEST_P(CaptureTest, EveryModeMatchesTheCpuReference) {
     }
 }
 
+// Named "glossy_order3_grey" etc., so CTest lists the case rather than the parameter's bytes.
 INSTANTIATE_TEST_SUITE_P(Orders, CaptureTest,
                          ::testing::Values(CaptureCase{3, prt::TransferKind::kGlossy, false},
                                            CaptureCase{6, prt::TransferKind::kGlossy, true},
-                                           CaptureCase{4, prt::TransferKind::kDiffuse, false}));
+                                           CaptureCase{4, prt::TransferKind::kDiffuse, false}),
+                         [](const ::testing::TestParamInfo<CaptureCase>& p) {
+                           return std::string(prt::transfer_kind_name(p.param.kind)) + "_order" +
+                                  std::to_string(p.param.order) +
+                                  (p.param.coloured ? "_rgb" : "_grey");
+                         });
 
 TEST(Renderer, UncompressedCaptureMatchesLosslessReference) {
   render::GlContext ctx;

@@ -1,8 +1,10 @@
 // tests/test_support.h: helpers shared by the test suites (scratch files, byte patching of
-// binary files, quadrature).
+// binary files, the damaged-file harness, quadrature).
 #pragma once
 
 #include "common/hash.h"
+
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +13,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -54,6 +58,44 @@ void patch(const std::filesystem::path& p, std::size_t offset, T value) {
   f.write(reinterpret_cast<const char*>(&value), sizeof(T));
   if (!f) throw std::runtime_error("cannot patch " + p.string());
 }
+
+// The message of the `Error` that `read(p)` throws, checked to name the file and to contain
+// `expected`; a test failure (and "") when it throws nothing.
+template <class Error, class Read>
+std::string error_of(const std::filesystem::path& p, Read read, const std::string& expected) {
+  try {
+    read(p);
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(p.string()), std::string::npos) << "message does not name the file: " << msg;
+    EXPECT_NE(msg.find(expected), std::string::npos) << "expected '" << expected << "' in: " << msg;
+    return msg;
+  }
+  ADD_FAILURE() << p << ": expected an error mentioning '" << expected << "'";
+  return {};
+}
+
+// "Each kind of damage has its own message", the harness of the file-format suites: each
+// damaged file's message is recorded under the kind of damage; at the end no two kinds may
+// share a message once the file name (everything up to the first ": ") is taken out, and
+// exactly `kinds` must have been tried, so a case that silently stops running is noticed.
+class DamageMessages {
+ public:
+  void record(const std::string& kind, const std::string& message) { messages_[kind] = message; }
+
+  void expect_distinct(std::size_t kinds) const {
+    std::set<std::string> problems;
+    for (const auto& [kind, msg] : messages_) {
+      const std::size_t colon = msg.find(": ");
+      ASSERT_NE(colon, std::string::npos) << kind << ": " << msg;
+      EXPECT_TRUE(problems.insert(msg.substr(colon + 2)).second) << kind << " repeats: " << msg;
+    }
+    EXPECT_EQ(messages_.size(), kinds);
+  }
+
+ private:
+  std::map<std::string, std::string> messages_;  // kind -> message
+};
 
 // Recomputes a header checksum (FNV-1a of the bytes before it, stored at `checksum_offset`),
 // so that a patched field is caught by its own check rather than by the checksum.

@@ -114,16 +114,7 @@ void expect_same(const TransferSet& a, const TransferSet& b) {
 // file nor `expected`.
 template <class Read>
 std::string error_of(const fs::path& p, Read read, const std::string& expected) {
-  try {
-    read(p);
-  } catch (const prt::TransferFileError& e) {
-    const std::string msg = e.what();
-    EXPECT_NE(msg.find(p.string()), std::string::npos) << "message does not name the file: " << msg;
-    EXPECT_NE(msg.find(expected), std::string::npos) << "expected '" << expected << "' in: " << msg;
-    return msg;
-  }
-  ADD_FAILURE() << p << ": expected a TransferFileError mentioning '" << expected << "'";
-  return {};
+  return test_support::error_of<prt::TransferFileError>(p, read, expected);
 }
 
 std::string read_error(const fs::path& p, const std::string& expected) {
@@ -347,14 +338,14 @@ TEST(TransferFile, DocumentedOffsetsAndIndexFormula) {
 TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
   const TransferSet set = make_set(TransferKind::kGlossy, 2, 3, 5, prt::MaterialKind::kPhong, 3);
   const std::size_t payload_bytes = 4 * set.data.size();
-  std::map<std::string, std::string> messages;  // case -> message
+  test_support::DamageMessages messages;
   const auto fresh = [&](const std::string& name) {
     const fs::path p = scratch("damaged_" + name + ".prtx");
     prt::write_transfer(p, set);
     return p;
   };
   const auto check = [&](const std::string& name, const fs::path& p, const std::string& expected) {
-    messages[name] = read_error(p, expected);
+    messages.record(name, read_error(p, expected));
   };
 
   {
@@ -539,15 +530,7 @@ TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
     check("directory", p, "is a directory");
   }
 
-  // Distinct: no two kinds of damage share a message (each names its own file anyway, so
-  // compare with the file name taken out).
-  std::set<std::string> problems;
-  for (const auto& [name, msg] : messages) {
-    const std::size_t colon = msg.find(": ");
-    ASSERT_NE(colon, std::string::npos) << name << ": " << msg;
-    EXPECT_TRUE(problems.insert(msg.substr(colon + 2)).second) << name << " repeats: " << msg;
-  }
-  EXPECT_EQ(messages.size(), 28u);
+  messages.expect_distinct(28);
 }
 
 // --- Writing ---------------------------------------------------------------------------------

@@ -3,11 +3,11 @@
 // coalesced requests share one frame, clients are served in turn), the JPEG path (the tone
 // map against render::tone_map itself, a JPEG round trip through libjpeg-turbo's decoder),
 // and the camera and environment a state asks for.
-#include "view_encode.h"
-#include "view_frame.h"
-#include "view_queue.h"
-#include "view_request.h"
-#include "view_scene.h"
+#include "viewer/encode.h"
+#include "viewer/frame.h"
+#include "viewer/queue.h"
+#include "viewer/request.h"
+#include "viewer/scene.h"
 
 #include "meshes/procedural.h"
 #include "render/image.h"
@@ -22,11 +22,11 @@
 
 namespace {
 
-using prtr_app::FrameQueue;
-using prtr_app::QueryParams;
-using prtr_app::RequestError;
-using prtr_app::ViewLimits;
-using prtr_app::ViewState;
+using viewer::FrameQueue;
+using viewer::QueryParams;
+using viewer::RequestError;
+using viewer::ViewLimits;
+using viewer::ViewState;
 
 ViewLimits limits() {
   ViewLimits l;
@@ -40,7 +40,7 @@ TEST(ViewRequest, NoParametersGiveTheDefaults) {
   ViewState d;
   d.width = 320;
   d.probe = 2;
-  const ViewState s = prtr_app::parse_view_request({}, limits(), d);
+  const ViewState s = viewer::parse_view_request({}, limits(), d);
   EXPECT_EQ(s.width, 320);
   EXPECT_EQ(s.probe, 2);
   EXPECT_EQ(s.mode, render::Mode::kDecoupled);
@@ -52,7 +52,7 @@ TEST(ViewRequest, EveryParameterLandsInTheState) {
       {"env_yaw", "-30.5"},  {"env_pitch", "12"},   {"cam_yaw", "90"},     {"cam_pitch", "-45"},
       {"zoom", "1.5"},       {"mode", "multipass"}, {"strategy", "order"}, {"budget", "512"},
       {"cpp", "4"},          {"probe", "1"},        {"exposure", "-1.25"}, {"overlay", "overdraw"}};
-  const ViewState s = prtr_app::parse_view_request(q, limits());
+  const ViewState s = viewer::parse_view_request(q, limits());
   EXPECT_EQ(s.client, "tab-1_x");
   EXPECT_EQ(s.seq, 42u);
   EXPECT_EQ(s.width, 640);
@@ -68,8 +68,8 @@ TEST(ViewRequest, EveryParameterLandsInTheState) {
   EXPECT_EQ(s.clusters_per_pass, 4);
   EXPECT_EQ(s.probe, 1);
   EXPECT_EQ(s.exposure, -1.25);
-  EXPECT_EQ(s.overlay, prtr_app::Overlay::kOverdraw);
-  EXPECT_EQ(q.size(), prtr_app::view_parameter_names().size());  // all of them were covered
+  EXPECT_EQ(s.overlay, viewer::Overlay::kOverdraw);
+  EXPECT_EQ(q.size(), viewer::view_parameter_names().size());  // all of them were covered
 }
 
 TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
@@ -115,7 +115,7 @@ TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
   };
   for (const Case& c : cases) {
     try {
-      prtr_app::parse_view_request(c.query, limits());
+      viewer::parse_view_request(c.query, limits());
       ADD_FAILURE() << "accepted " << c.query.begin()->first << "=" << c.query.begin()->second;
     } catch (const RequestError& e) {
       const std::string what = e.what();
@@ -126,10 +126,40 @@ TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
   }
 }
 
+TEST(ViewRequest, RawQueriesAreSplitStrictly) {
+  const QueryParams q = viewer::parse_query("w=480&mode=cpu&client=a%2Db&probe=1+");
+  const QueryParams expected{{"w", "480"}, {"mode", "cpu"}, {"client", "a-b"}, {"probe", "1 "}};
+  EXPECT_EQ(q, expected);
+  EXPECT_TRUE(viewer::parse_query("").empty());
+  // Each malformed query is refused with a one-line reason naming what is wrong.
+  const std::pair<std::string, std::string> bad[] = {
+      {"w=abc=480", "'=' in its value"},
+      {"mode=bogus=cpu", "'=' in its value"},
+      {"w=960;h=710", "';'"},
+      {"w=480&w=480", "repeated"},
+      {"client=a&client=a", "repeated"},
+      {"w", "no value"},
+      {"w=1&&h=2", "empty parameter"},
+      {"w=1&", "empty parameter"},
+      {"w=%zz", "%-escape"},
+      {"w=%4", "%-escape"},
+  };
+  for (const auto& [query, reason] : bad) {
+    try {
+      viewer::parse_query(query);
+      ADD_FAILURE() << "accepted " << query;
+    } catch (const RequestError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(reason), std::string::npos) << query << ": " << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+}
+
 TEST(ViewRequest, UncompressedIsAcceptedWhenTheTransferIsAtHand) {
   ViewLimits l = limits();
   l.uncompressed = true;
-  EXPECT_EQ(prtr_app::parse_view_request({{"mode", "uncompressed"}}, l).mode,
+  EXPECT_EQ(viewer::parse_view_request({{"mode", "uncompressed"}}, l).mode,
             render::Mode::kUncompressed);
 }
 
@@ -141,8 +171,8 @@ ViewState state_of(const std::string& client, std::uint64_t seq, double yaw = 0)
   return s;
 }
 
-std::shared_ptr<prtr_app::RenderedFrame> frame_for(const ViewState& s) {
-  auto f = std::make_shared<prtr_app::RenderedFrame>();
+std::shared_ptr<viewer::RenderedFrame> frame_for(const ViewState& s) {
+  auto f = std::make_shared<viewer::RenderedFrame>();
   f->state = s;
   return f;
 }
@@ -186,13 +216,13 @@ TEST(ViewQueue, RefusesTooManyClientsAndFailsWaitersOnStop) {
   FrameQueue q(2);
   auto a = q.submit(state_of("a", 1));
   auto b = q.submit(state_of("b", 1));
-  EXPECT_THROW(q.submit(state_of("c", 1)), prtr_app::QueueRefused);
+  EXPECT_THROW(q.submit(state_of("c", 1)), viewer::QueueRefused);
   EXPECT_NO_THROW(q.submit(state_of("a", 2)));  // a waiting client may still coalesce
   q.stop();
-  EXPECT_THROW(a.get(), prtr_app::QueueRefused);
-  EXPECT_THROW(b.get(), prtr_app::QueueRefused);
+  EXPECT_THROW(a.get(), viewer::QueueRefused);
+  EXPECT_THROW(b.get(), viewer::QueueRefused);
   EXPECT_FALSE(q.take());
-  EXPECT_THROW(q.submit(state_of("a", 3)), prtr_app::QueueRefused);
+  EXPECT_THROW(q.submit(state_of("a", 3)), viewer::QueueRefused);
 }
 
 // Four clients submit as fast as they can while one thread renders: every request gets a
@@ -208,7 +238,7 @@ TEST(ViewQueue, ConcurrentClientsEachGetTheirNewestFrame) {
     clients.emplace_back([&, c] {
       const std::string id = "client" + std::to_string(c);
       for (std::uint64_t seq = 1; seq <= 200; ++seq) {
-        const prtr_app::FramePtr f = q.submit(state_of(id, seq)).get();
+        const viewer::FramePtr f = q.submit(state_of(id, seq)).get();
         if (f->state.client != id || f->state.seq < seq) ++wrong;
         ++answered;
       }
@@ -252,56 +282,55 @@ TEST(ViewEncode, JpegRoundTripAndOverlay) {
       p[1] = std::uint8_t(y * 5);
       p[2] = 128;
     }
-  render::Picture overlay(w, h, prtr_app::kOverlayTransparent);
+  render::Picture overlay(w, h, viewer::kOverlayTransparent);
   overlay.set(10, 10, {0, 0, 0});
   std::vector<std::uint8_t> mixed = rgb;
-  prtr_app::composite_overlay(mixed, w, h, overlay, 0.5);
+  viewer::composite_overlay(mixed, w, h, overlay, 0.5);
   EXPECT_EQ(mixed[(10 * w + 10) * 3 + 2], 64);  // half of 128 over black
   mixed[(10 * w + 10) * 3 + 0] = rgb[(10 * w + 10) * 3 + 0];
   mixed[(10 * w + 10) * 3 + 1] = rgb[(10 * w + 10) * 3 + 1];
   mixed[(10 * w + 10) * 3 + 2] = rgb[(10 * w + 10) * 3 + 2];
   EXPECT_EQ(mixed, rgb);  // every transparent pixel untouched
 
-  const std::vector<std::uint8_t> jpeg = prtr_app::encode_jpeg(rgb, w, h, 90);
+  const std::vector<std::uint8_t> jpeg = viewer::encode_jpeg(rgb, w, h, 90);
   ASSERT_GT(jpeg.size(), 4u);
   EXPECT_EQ(jpeg[0], 0xFF);
   EXPECT_EQ(jpeg[1], 0xD8);
   int dw = 0, dh = 0;
-  const std::vector<std::uint8_t> back = prtr_app::decode_jpeg(jpeg, dw, dh);
+  const std::vector<std::uint8_t> back = viewer::decode_jpeg(jpeg, dw, dh);
   EXPECT_EQ(dw, w);
   EXPECT_EQ(dh, h);
   double error = 0;
   for (std::size_t i = 0; i < rgb.size(); ++i) error += std::abs(int(back[i]) - int(rgb[i]));
   EXPECT_LT(error / double(rgb.size()), 3.0);
-  EXPECT_THROW(prtr_app::encode_jpeg(rgb, w + 1, h), std::invalid_argument);
+  EXPECT_THROW(viewer::encode_jpeg(rgb, w + 1, h), std::invalid_argument);
 }
 
 TEST(ViewCamera, OrbitAndZoomMoveTheEyeAboutTheTarget) {
   const meshes::Mesh mesh = meshes::make_sphere(1.f, 16, 8);
-  prtr_app::ViewFlags flags;
+  const render::CameraPlacement flags;
   ViewState s;
   s.width = 64;
   s.height = 48;
-  const render::Camera base = prtr_app::view_camera(flags, mesh, s);
+  const render::Camera base = viewer::view_camera(flags, mesh, s);
   EXPECT_EQ(base.width, 64);
   const double distance = (base.eye - base.target).norm();
   s.zoom = 2;
-  const render::Camera closer = prtr_app::view_camera(flags, mesh, s);
+  const render::Camera closer = viewer::view_camera(flags, mesh, s);
   EXPECT_NEAR((closer.eye - closer.target).norm(), distance / 2, 1e-9);
   s.zoom = 1;
   s.cam_yaw = 90;
-  const render::Camera side = prtr_app::view_camera(flags, mesh, s);
+  const render::Camera side = viewer::view_camera(flags, mesh, s);
   // The default camera looks down -Z; a quarter turn about +Y looks down -X.
   const Eigen::Vector3d forward = (side.target - side.eye).normalized();
   EXPECT_NEAR(forward.x(), -1.0, 1e-9);
   EXPECT_NEAR((side.eye - side.target).norm(), distance, 1e-9);
   EXPECT_NO_THROW(side.validate());
-  const Eigen::Matrix3d none =
-      prtr_app::environment_rotation(Eigen::Vector3d::UnitY(), ViewState{});
+  const Eigen::Matrix3d none = viewer::environment_rotation(Eigen::Vector3d::UnitY(), ViewState{});
   EXPECT_TRUE(none.isApprox(Eigen::Matrix3d::Identity()));
   ViewState turned;
   turned.env_yaw = 90;
-  const Eigen::Matrix3d r = prtr_app::environment_rotation(Eigen::Vector3d::UnitY(), turned);
+  const Eigen::Matrix3d r = viewer::environment_rotation(Eigen::Vector3d::UnitY(), turned);
   EXPECT_TRUE((r * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitX(), 1e-12));
 }
 

@@ -2,11 +2,11 @@
 // to the file block by block (prt::bake_to_file), so the payload never sits in memory whole.
 #include "bake_flags.h"
 #include "commands.h"
+#include "common/json.h"
 #include "flag_checks.h"
-#include "json_output.h"
 #include "meshes/load.h"
 #include "mpi_world.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "progress_bar.h"
 #include "prt/transfer_file.h"
 #include "prt/transfer_shard.h"
@@ -19,6 +19,8 @@
 #include <vector>
 
 namespace prtr_app {
+using common::dump_json;
+using common::Json;
 namespace {
 
 // "k/n" as {k, n}; {0, 0} for no shard.

@@ -1,15 +1,15 @@
 // prtr compress TRANSFER --mesh MESH -o FILE: clustered PCA of a bake (LBG or iterative CPCA,
 // optional geometry coherence and overdraw-aware reassignment), with a one-screen report.
 #include "commands.h"
+#include "common/json.h"
 #include "compress_flags.h"
 #include "flag_checks.h"
-#include "json_output.h"
 #include "mpi_world.h"
 
 #include "cpca/compress.h"
 #include "cpca/compressed_file.h"
 #include "meshes/load.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "progress_bar.h"
 #include "prt/mapped_transfer.h"
 #include "prt/transfer_file.h"
@@ -20,6 +20,8 @@
 #include <string>
 
 namespace prtr_app {
+using common::dump_json;
+using common::Json;
 namespace {
 
 struct Options {
@@ -166,8 +168,9 @@ void mpi_compress(const Options& o, const cpca::CompressOptions& options) {
     const prt::TransferSet& transfer = mapped.header();
     const cpca::RowBlocks blocks = row_blocks(mapped, o.block_vertices);
     cpca::CompressReport report;
-    const cpca::CompressedSet set = run_compress(transfer, blocks, mesh, o.mesh, options,
-                                                 o.quiet || o.json || !root, &report, dist.get());
+    const cpca::CompressedSet set =
+        pipeline::run_compress(transfer, blocks, mesh, o.mesh, options,
+                               stderr_reporter(o.quiet || o.json || !root), &report, dist.get());
     if (root) {
       cpca::write_compressed(o.output, set);
       print_report(o, set, report, transfer, mesh);
@@ -208,8 +211,8 @@ Runner add_compress_command(CLI::App& app) {
     const prt::TransferSet& transfer = mapped.header();
     const cpca::RowBlocks blocks = row_blocks(mapped, o.block_vertices);
     cpca::CompressReport report;
-    const cpca::CompressedSet set =
-        run_compress(transfer, blocks, mesh, o.mesh, options, o.quiet || o.json, &report);
+    const cpca::CompressedSet set = pipeline::run_compress(
+        transfer, blocks, mesh, o.mesh, options, stderr_reporter(o.quiet || o.json), &report);
     cpca::write_compressed(o.output, set);
     print_report(o, set, report, transfer, mesh);
   };

@@ -9,9 +9,9 @@
 #include "compress_flags.h"
 #include "flag_checks.h"
 #include "gl_flags.h"
-#include "overdraw_plot.h"
-#include "overdraw_run.h"
-#include "pipeline.h"
+#include "overdraw/plot.h"
+#include "overdraw/run.h"
+#include "pipeline/pipeline.h"
 #include "progress_bar.h"
 #include "subprocess.h"
 
@@ -30,6 +30,10 @@
 
 namespace prtr_app {
 namespace {
+
+using overdraw::OverdrawPlan;
+using overdraw::OverdrawReport;
+using overdraw::PlanError;
 
 namespace fs = std::filesystem;
 
@@ -88,7 +92,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_flag("--recompress", o.recompress, "Ignore cached compressions (still writes them)");
   cmd->add_option("--clusters", o.clusters, "Cluster counts K, comma separated")
       ->capture_default_str();
-  cmd->add_option("--rows", o.rows, "Methods: " + method_names())->capture_default_str();
+  cmd->add_option("--rows", o.rows, "Methods: " + overdraw::method_names())->capture_default_str();
   cmd->add_option("--strategies", o.strategies,
                   "Super-cluster strategies: " + cpca::supercluster_strategy_names())
       ->capture_default_str();
@@ -154,7 +158,7 @@ OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
   plan.mesh = o.mesh;
   plan.probe = o.probe;
   plan.transfer = o.transfer;
-  plan.cache = o.cache.empty() ? default_cache_dir().string() : o.cache;
+  plan.cache = o.cache.empty() ? pipeline::default_cache_dir().string() : o.cache;
   plan.recompress = o.recompress;
   plan.compress = resolve_compress_flags(o.compress);
   plan.frames = o.frames;
@@ -164,7 +168,7 @@ OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
   plan.height = o.height;
   plan.degrees_per_frame = o.degrees_per_frame;
   plan.modes = !o.no_modes;
-  plan.quiet = o.quiet;
+  plan.reporter = stderr_reporter(o.quiet);
   plan.gl = gl_selection(o.gl);
   plan.pictures = o.out;
   return plan;
@@ -205,30 +209,31 @@ std::string write_plots(const OverdrawReport& report, const OverdrawPlan& plan, 
       o.pareto_plot.empty() ? out / "overdraw-pareto.png" : fs::path(o.pareto_plot);
   const fs::path timing =
       o.timing_plot.empty() ? out / "overdraw-timing.png" : fs::path(o.timing_plot);
-  const std::string budget = plot_budget(plan.budgets);
+  const std::string budget = overdraw::plot_budget(plan.budgets);
   render::write_picture_png(
-      pareto, pareto_plot(report, budget,
-                          budget == "thesis" ? thesis_best_overdraw() : std::map<int, double>{}));
-  render::write_picture_png(timing, timing_plot(report));
+      pareto, overdraw::pareto_plot(
+                  report, budget,
+                  budget == "thesis" ? overdraw::thesis_best_overdraw() : std::map<int, double>{}));
+  render::write_picture_png(timing, overdraw::timing_plot(report));
   return pareto.string() + " and " + timing.string();
 }
 
 void write_outputs(const OverdrawReport& report, const OverdrawPlan& plan, const Options& o) {
   const bool as_json = o.json;
   const fs::path out = plan.pictures;
-  const std::string csv_text = csv(report), json_text = json(report), fit_text = fit_csv(report);
+  const std::string csv_text = overdraw::csv(report), json_text = overdraw::json(report),
+                    fit_text = overdraw::fit_csv(report);
   common::write_file_atomically(out / "overdraw.csv", csv_text.data(), csv_text.size());
   common::write_file_atomically(out / "overdraw-fit.csv", fit_text.data(), fit_text.size());
   common::write_file_atomically(out / "overdraw.json", json_text.data(), json_text.size());
   const std::string plots = write_plots(report, plan, o);
-  const std::string plotted = plot(out / "overdraw.csv", plot_budget(plan.budgets));
+  const std::string plotted = plot(out / "overdraw.csv", overdraw::plot_budget(plan.budgets));
   if (as_json) {
     std::fputs(json_text.c_str(), stdout);
-    if (!plan.quiet)
-      std::fprintf(stderr, "overdraw: plots %s; %s\n", plots.c_str(), plotted.c_str());
+    if (!o.quiet) std::fprintf(stderr, "overdraw: plots %s; %s\n", plots.c_str(), plotted.c_str());
     return;
   }
-  std::fputs(markdown(report).c_str(), stdout);
+  std::fputs(overdraw::markdown(report).c_str(), stdout);
   std::printf(
       "\nWrote %s/overdraw.csv, overdraw-fit.csv, overdraw.json and the K=%d cluster and "
       "overdraw pictures; plots %s; %s\n",
@@ -259,7 +264,7 @@ Runner add_overdraw_command(CLI::App& app) {
     }
     OverdrawReport report;
     try {
-      report = run_overdraw(plan);
+      report = overdraw::run_overdraw(plan);
     } catch (const PlanError& e) {
       throw UsageError(e.what());
     }

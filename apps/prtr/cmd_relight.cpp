@@ -13,8 +13,7 @@
 #include "flag_checks.h"
 #include "gl_flags.h"
 #include "meshes/load.h"
-#include "pass_grouping.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "probes/load.h"
 #include "progress_bar.h"
 #include "prt/projection.h"
@@ -22,6 +21,7 @@
 #include "render/gif.h"
 #include "render/gl_context.h"
 #include "render/image.h"
+#include "render/pass_grouping.h"
 #include "render/renderer.h"
 #include "view_flags.h"
 
@@ -142,13 +142,14 @@ void make_output_directory(const std::string& out) {
 // Bake and compress through the cache, reporting hits and times; the compressed set's path.
 fs::path bake_and_compress(const Options& o, const meshes::Mesh& mesh, const prt::BakeOptions& bake,
                            const cpca::CompressOptions& compress) {
-  const fs::path cache = o.cache.empty() ? default_cache_dir() : fs::path(o.cache);
+  const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
   const auto t_bake = Clock::now();
-  const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
+  const pipeline::Reporter reporter = stderr_reporter(o.quiet);
+  const pipeline::CacheResult transfer = pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
   const double bake_s = seconds_since(t_bake);
   const auto t_compress = Clock::now();
-  const CompressCacheResult compressed =
-      cached_compress(transfer.path, mesh, o.mesh, compress, cache, o.quiet);
+  const pipeline::CompressCacheResult compressed =
+      pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
   const double compress_s = seconds_since(t_compress);
   std::printf("bake        %s %s (%.1f s)\n", transfer.hit ? "cached" : "baked",
               transfer.path.string().c_str(), bake_s);
@@ -164,9 +165,9 @@ std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::
   render::RendererOptions ro;
   ro.mode = render::parse_mode(o.mode);
   ro.register_budget = o.register_budget;
-  if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
-    ro.groups = group_for_renderer(mesh, set, context, o.register_budget, 0, o.strategy);
   try {
+    if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
+      ro.groups = render::group_for_renderer(mesh, set, context, o.register_budget, 0, o.strategy);
     auto renderer = std::make_unique<render::Renderer>(mesh, &set, nullptr, &probe, ro);
     renderer->set_background(resolve_background(o.view));
     return renderer;

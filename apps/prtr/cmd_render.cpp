@@ -2,10 +2,10 @@
 // (OSMesa/llvmpipe), write linear EXR (+ tone-mapped PNG) and report passes, overdraw and
 // frame times (render/renderer.h describes the modes).
 #include "commands.h"
+#include "common/json.h"
 #include "flag_checks.h"
 #include "gl_flags.h"
-#include "json_output.h"
-#include "pass_grouping.h"
+#include "render/pass_grouping.h"
 #include "view_flags.h"
 
 #include "cpca/compressed_file.h"
@@ -30,6 +30,8 @@
 #include <vector>
 
 namespace prtr_app {
+using common::dump_json;
+using common::Json;
 namespace {
 
 // "[a,b,c]": the per-pass triangle counts, as the text report and error messages show them.
@@ -226,11 +228,11 @@ Runner add_render_command(CLI::App& app) {
     const render::Camera camera = resolve_camera(o.view, mesh);
 
     render::GlContext context(gl);
-    if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
-      ro.groups = group_for_renderer(mesh, set, context, o.register_budget, o.clusters_per_pass,
-                                     o.strategy);
     std::unique_ptr<render::Renderer> renderer;
     try {
+      if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
+        ro.groups = render::group_for_renderer(mesh, set, context, o.register_budget,
+                                               o.clusters_per_pass, o.strategy);
       renderer = std::make_unique<render::Renderer>(mesh, &set, transfer ? &*transfer : nullptr,
                                                     &probe, ro);
     } catch (const std::invalid_argument& e) {

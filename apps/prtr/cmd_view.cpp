@@ -9,11 +9,12 @@
 #include "flag_checks.h"
 #include "gl_flags.h"
 #include "meshes/load.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 #include "probes/load.h"
+#include "progress_bar.h"
 #include "view_flags.h"
-#include "view_scene.h"
-#include "view_server.h"
+#include "viewer/scene.h"
+#include "viewer/server.h"
 
 #include <algorithm>
 #include <cctype>
@@ -24,15 +25,20 @@
 #include <vector>
 
 namespace prtr_app {
+using common::Json;
 namespace fs = std::filesystem;
 namespace {
+
+using viewer::SceneInfo;
+using viewer::ServedInfo;
+using viewer::ViewState;
 
 struct Options {
   std::string mesh, probe, cache, mode = "decoupled", strategy = "greedy-refine";
   BakeFlags bake;
   CompressFlags compress;
   ViewFlags view;
-  ServerOptions server;
+  viewer::ServerOptions server;
   GlFlags gl;
   int register_budget = 0;
   bool quiet = false;
@@ -90,7 +96,7 @@ std::vector<fs::path> scan_probes(const fs::path& given, int& index) {
 }
 
 Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::CompressedSet& set,
-               const CompressionSummary& summary, const SceneInfo& scene,
+               const pipeline::CompressionSummary& summary, const SceneInfo& scene,
                const std::vector<fs::path>& probes, const ServedInfo& served) {
   Json names = Json::array();
   for (const fs::path& p : probes) names.push_back(p.filename().string());
@@ -154,7 +160,9 @@ Runner add_view_command(CLI::App& app) {
     const Options& o = *opt;
     const prt::BakeOptions bake = resolve_bake_flags(o.bake);
     const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
-    resolve_background(o.view);
+    const render::Background background = resolve_background(o.view);
+    const Eigen::Vector3d axis = resolve_axis(o.view);
+    const render::CameraPlacement placement = resolve_placement(o.view);
     const render::GlSelection gl = gl_selection(o.gl);
     int probe_index = 0;
     const std::vector<fs::path> probes = scan_probes(o.probe, probe_index);
@@ -163,12 +171,14 @@ Runner add_view_command(CLI::App& app) {
     const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
     resolve_camera(o.view, mesh);
     probes::load_probe(o.probe);  // fail before the long work
-    const fs::path cache = o.cache.empty() ? default_cache_dir() : fs::path(o.cache);
-    const CacheResult transfer = cached_bake(mesh, o.mesh, bake, cache, o.quiet);
-    const CompressCacheResult compressed =
-        cached_compress(transfer.path, mesh, o.mesh, compress, cache, o.quiet);
+    const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
+    const pipeline::Reporter reporter = stderr_reporter(o.quiet);
+    const pipeline::CacheResult transfer =
+        pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
+    const pipeline::CompressCacheResult compressed =
+        pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
     const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
-    ViewScene scene({&mesh, &set, transfer.path, probes, o.view, gl});
+    viewer::ViewScene scene({&mesh, &set, transfer.path, probes, placement, background, axis, gl});
     served.limits = {int(probes.size()), set.cluster_count, true};
     // The initial state renders once here, so a flag the renderer refuses exits 2 now.
     const auto first = scene.render(served.defaults);
@@ -178,7 +188,7 @@ Runner add_view_command(CLI::App& app) {
     std::printf("prtr view: %s, %d clusters x %d PCs, order %d; first frame %.0f ms\n",
                 o.mesh.c_str(), set.cluster_count, set.component_count, set.order,
                 first->stats.render_ms);
-    serve_view(scene, served, o.server);
+    viewer::serve_view(scene, served, o.server);
   };
 }
 

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <memory>
 
 namespace prtr_app {
 
@@ -45,17 +46,16 @@ void ProgressBar::finish() {
   label_.clear();
 }
 
-std::string format_bytes(std::uint64_t bytes) {
-  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
-  double value = double(bytes);
-  int unit = 0;
-  while (value >= 1024.0 && unit < 4) {
-    value /= 1024.0;
-    ++unit;
-  }
-  char buf[32];
-  std::snprintf(buf, sizeof buf, unit == 0 ? "%.0f %s" : "%.1f %s", value, units[unit]);
-  return buf;
+pipeline::Reporter stderr_reporter(bool quiet) {
+  auto bar = std::make_shared<ProgressBar>(quiet);
+  pipeline::Reporter r;
+  r.progress = [bar](const std::string& phase, std::uint64_t done, std::uint64_t total) {
+    bar->update(phase, done, total);
+  };
+  r.step_done = [bar] { bar->finish(); };
+  if (!quiet) r.note = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
+  r.warning = [](const std::string& line) { std::fprintf(stderr, "prtr: %s\n", line.c_str()); };
+  return r;
 }
 
 }  // namespace prtr_app

@@ -3,6 +3,9 @@
 // and CI output stay clean.
 #pragma once
 
+#include "common/format_bytes.h"
+#include "pipeline/reporter.h"
+
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -26,7 +29,10 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_;
 };
 
-// "1.2 GiB", "34.0 MiB", ...
-std::string format_bytes(std::uint64_t bytes);
+// The pipeline's news on stderr: a progress bar and notes unless `quiet`, warnings always
+// (prefixed "prtr: ").
+pipeline::Reporter stderr_reporter(bool quiet);
+
+using common::format_bytes;
 
 }  // namespace prtr_app

@@ -1,7 +1,7 @@
 #include "start_sweep.h"
 
 #include "common/atomic_file.h"
-#include "pipeline.h"
+#include "pipeline/pipeline.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -21,7 +21,7 @@ void sweep_command_folders(const CLI::App& command) {
     if (!file && !folder && !cache) continue;
     // The value given, else the default the command will use.
     std::string value = option->count() > 0 ? option->as<std::string>() : option->get_default_str();
-    if (value.empty() && cache) value = default_cache_dir().string();
+    if (value.empty() && cache) value = pipeline::default_cache_dir().string();
     if (value.empty()) continue;
     const fs::path path(value);
     folders.insert(file ? (path.has_parent_path() ? path.parent_path() : fs::path(".")) : path);

@@ -58,22 +58,26 @@ Eigen::Vector3d parse_vector(const std::string& text, const char* flag) {
   return {values[0], values[1], values[2]};
 }
 
+render::CameraPlacement resolve_placement(const ViewFlags& f) {
+  render::CameraPlacement placement;
+  placement.fov_y_degrees = f.fov;
+  if (!f.target.empty()) placement.target = parse_vector(f.target, "--target");
+  if (!f.eye.empty()) placement.eye = parse_vector(f.eye, "--eye");
+  if (!f.up.empty()) placement.up = parse_vector(f.up, "--up");
+  return placement;
+}
+
 render::Camera resolve_camera(const ViewFlags& f, const meshes::Mesh& mesh) {
+  const render::CameraPlacement placement = resolve_placement(f);
   const Eigen::Vector3d centre = meshes::bounds(mesh).center().cast<double>();
   double radius = 0.0;
   for (const auto& p : mesh.positions)
     radius = std::max(radius, (p.cast<double>() - centre).norm());
-  render::Camera camera = render::frame_sphere(centre, radius, f.width, f.height, f.fov);
-  if (!f.target.empty()) camera.target = parse_vector(f.target, "--target");
-  if (!f.eye.empty()) camera.eye = parse_vector(f.eye, "--eye");
-  if (!f.up.empty()) camera.up = parse_vector(f.up, "--up");
-  render::fit_clip_planes(camera, centre, radius);
   try {
-    camera.validate();
+    return render::place_camera(placement, centre, radius, f.width, f.height);
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
-  return camera;
 }
 
 render::Background resolve_background(const ViewFlags& f) {

@@ -24,6 +24,8 @@ void add_view_flags(CLI::App* command, ViewFlags& flags);
 // "x,y,z" -> vector; UsageError naming the flag otherwise.
 Eigen::Vector3d parse_vector(const std::string& text, const char* flag);
 
+// --eye/--target/--up/--fov as a placement (UsageError naming a malformed flag).
+render::CameraPlacement resolve_placement(const ViewFlags& flags);
 // The default camera frames the mesh's bounding sphere; --eye/--target/--up override it.
 render::Camera resolve_camera(const ViewFlags& flags, const meshes::Mesh& mesh);
 render::Background resolve_background(const ViewFlags& flags);

@@ -239,6 +239,7 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
     if (progress) progress(stage, std::clamp(fraction, 0.0, 1.0));
   };
 
+  // 1. LBG clustering, geometry-coherent when alpha > 0.
   auto t = Clock::now();
   std::unique_ptr<GeometryCoherence> coherence;
   if (options.alpha > 0)
@@ -266,6 +267,7 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
   notify("pca", 1);
   if (!dist.first()) return set;  // rank 0 holds the whole set
 
+  // 3. Iterative CPCA (Sloan et al. 2003), when asked for.
   int iterations = clustering.iterations;
   if (options.method == ClusterMethod::kIterative) {
     t = Clock::now();
@@ -285,6 +287,7 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
     r.overdraw_seconds = seconds_since(t);
     notify("overdraw", 1);
   }
+  // 5. The metrics of the final set.
   set.iterations = iterations;
   measure(data, options, geometry, set, vertex_error, r);
   r.total_seconds = seconds_since(start);

@@ -1,7 +1,9 @@
 #include "cpca/joint_search.h"
 
 #include "common/check.h"
+#include "cpca/assignment.h"
 #include "cpca/cluster_pca.h"
+#include "cpca/compress.h"
 #include "cpca/patch_first.h"
 #include "cpca/supercluster_incidence.h"
 #include "cpca/supercluster_refine.h"

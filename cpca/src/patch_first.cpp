@@ -1,6 +1,7 @@
 // Patch-first CPCA: METIS patches, then CPCA inside each.
 #include "cpca/patch_first.h"
 
+#include "cpca/compress.h"
 #include "metis_kway.h"
 
 #include <tbb/parallel_for.h>

@@ -6,23 +6,6 @@
 
 namespace cpca {
 
-int registers_per_cluster(int order, int components) {
-  if (order < 1 || components < 0)
-    throw std::invalid_argument("registers_per_cluster: order must be >= 1 and components >= 0");
-  const long floats = long(components + 1) * long(order) * long(order) * 3;
-  return int((floats + 3) / 4);
-}
-
-int clusters_per_pass(int register_budget, int order, int components) {
-  const int cost = registers_per_cluster(order, components);
-  if (register_budget < cost)
-    throw std::invalid_argument(
-        "register budget " + std::to_string(register_budget) + " is below one cluster's cost of " +
-        std::to_string(cost) + " vec4 (order " + std::to_string(order) + ", " +
-        std::to_string(components) + " PCs): raise --register-budget or lower the order or PCs");
-  return register_budget / cost;
-}
-
 std::vector<std::uint32_t> pass_of_clusters(const SuperClusters& groups, int cluster_count) {
   constexpr std::uint32_t kUnset = ~0u;
   std::vector<std::uint32_t> pass_of(std::size_t(cluster_count), kUnset);

@@ -67,6 +67,17 @@ void fit_clip_planes(Camera& camera, const Eigen::Vector3d& center, double radiu
   camera.near_plane = std::max(distance - margin, camera.far_plane * 1e-4);
 }
 
+Camera place_camera(const CameraPlacement& placement, const Eigen::Vector3d& center, double radius,
+                    int width, int height) {
+  Camera camera = frame_sphere(center, radius, width, height, placement.fov_y_degrees);
+  if (placement.target) camera.target = *placement.target;
+  if (placement.eye) camera.eye = *placement.eye;
+  if (placement.up) camera.up = *placement.up;
+  fit_clip_planes(camera, center, radius);
+  camera.validate();
+  return camera;
+}
+
 Camera frame_sphere(const Eigen::Vector3d& center, double radius, int width, int height,
                     double fov_y_degrees) {
   Camera c;

@@ -4,6 +4,7 @@
 // clusters are grouped into passes, how the constants are bound and who shades.
 #include "common/check.h"
 #include "render/gl_context.h"
+#include "render/pass_capacity.h"
 #include "render/shader_source.h"
 #include "render_path.h"
 
@@ -44,32 +45,15 @@ void end_radiance_feedback() {
   glDisable(GL_RASTERIZER_DISCARD);
 }
 
-// The vec4 budget of one pass, checked against the context and one cluster's cost, and the
-// clusters one pass holds. Messages name the flags, as these come from the command line.
-int clusters_per_pass(const PathInput& in, int registers) {
-  const int context_budget = current_gl_info().default_register_budget();
-  const int budget = in.options.register_budget > 0 ? in.options.register_budget : context_budget;
-  if (budget > context_budget)
-    throw std::invalid_argument("--register-budget " + std::to_string(budget) +
-                                " exceeds what the GL context offers (" +
-                                std::to_string(context_budget) + " vec4); lower it");
-  if (budget < registers)
-    throw std::invalid_argument(
-        "--register-budget " + std::to_string(budget) + " is below one cluster's " +
-        std::to_string(registers) + " vec4 (order " + std::to_string(in.set->order) + ", " +
-        std::to_string(in.set->component_count) + " PCs); raise it or use fewer PCs");
-  int per_pass = budget / registers;
-  if (in.options.clusters_per_pass > 0) {
-    if (in.options.clusters_per_pass > per_pass)
-      throw std::invalid_argument(
-          "--clusters-per-pass " + std::to_string(in.options.clusters_per_pass) + " needs " +
-          std::to_string(in.options.clusters_per_pass * registers) + " vec4 but the budget is " +
-          std::to_string(budget) + "; lower it or raise --register-budget");
-    per_pass = in.options.clusters_per_pass;
-  }
-  in.stats.register_budget = budget;
-  in.stats.registers_per_cluster = registers;
-  return per_pass;
+// The clusters one pass holds (render/pass_capacity.h refuses what does not fit); records the
+// budget and the cost in the stats.
+int clusters_per_pass(const PathInput& in) {
+  const PassCapacity capacity =
+      pass_capacity(*in.set, in.options.register_budget,
+                    current_gl_info().default_register_budget(), in.options.clusters_per_pass);
+  in.stats.register_budget = capacity.register_budget;
+  in.stats.registers_per_cluster = capacity.registers_per_cluster;
+  return capacity.clusters_per_pass;
 }
 
 // The grouping: the caller's (checked against the capacity) for the paths that split, else
@@ -132,7 +116,7 @@ class ClusterPath : public RenderPath {
   ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot,
               bool pass_blocks, bool legacy_sort, bool zero_copies = false)
       : constants_(*in.set), layout_(constants_.layout()) {
-    const int per_pass = clusters_per_pass(in, layout_.registers_per_cluster());
+    const int per_pass = clusters_per_pass(in);
     plan_ = plan_slots(group(in, per_pass, split), in.set->cluster_count,
                        layout_.registers_per_cluster(), per_cluster_aligned);
     host_.assign(std::size_t(plan_.total_slots) * layout_.floats_stride(), 0.f);

@@ -30,13 +30,17 @@ void basis_at(int order, bool glossy, const Eigen::Vector3d& local, float* y) {
 
 }  // namespace
 
-ConstantLayout constant_layout(const cpca::CompressedSet& set) {
+ConstantLayout constant_layout(int order, bool glossy, int components) {
   ConstantLayout l;
-  l.glossy = set.glossy();
-  l.order = l.glossy ? set.order : 1;
-  l.rows = rows_of(set.order, l.glossy);
-  l.terms = set.component_count + 1;
+  l.glossy = glossy;
+  l.order = glossy ? order : 1;
+  l.rows = rows_of(order, glossy);
+  l.terms = components + 1;
   return l;
+}
+
+ConstantLayout constant_layout(const cpca::CompressedSet& set) {
+  return constant_layout(set.order, set.glossy(), set.component_count);
 }
 
 ShadingConstants::ShadingConstants(const cpca::CompressedSet& set)
@@ -186,24 +190,6 @@ void exit_vectors(const prt::TransferSet& transfer,
           }
         }
       });
-}
-
-void shade_exit_vectors(const std::vector<float>& exit, int order, bool glossy,
-                        const meshes::Mesh& mesh, const Eigen::Vector3d& eye,
-                        std::vector<Rgb>& radiance) {
-  const int rows = rows_of(order, glossy);
-  const std::size_t vertex_count = mesh.vertex_count();
-  radiance.resize(vertex_count);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertex_count, 256),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      Eigen::VectorXf y(rows);
-                      for (std::size_t p = range.begin(); p < range.end(); ++p) {
-                        const Eigen::Vector3d local = local_view(mesh, p, eye);
-                        basis_at(order, glossy, local, y.data());
-                        radiance[p] =
-                            Eigen::Map<const RowMatrixXf>(exit.data() + p * 3 * rows, 3, rows) * y;
-                      }
-                    });
 }
 
 }  // namespace render

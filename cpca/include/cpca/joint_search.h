@@ -21,7 +21,7 @@
 // is exactly CompressOptions::method = kIterative (tested).
 #pragma once
 
-#include "cpca/compress.h"
+#include "cpca/compress_options.h"
 #include "cpca/supercluster.h"
 
 #include <cstdint>

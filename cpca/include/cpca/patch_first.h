@@ -11,7 +11,7 @@
 // holds [p * per_pass, (p + 1) * per_pass): the grouping is group_in_order(K, per_pass).
 #pragma once
 
-#include "cpca/compress.h"
+#include "cpca/compress_options.h"
 #include "cpca/supercluster.h"
 
 #include <cstdint>

@@ -15,15 +15,6 @@
 
 namespace cpca {
 
-// vec4 registers one cluster's constants take in the renderer's vertex shader: the n x 3
-// RGB radiance vectors a_k and b_kj (j < N), packed tightly as floats into vec4s:
-// ceil((N + 1) * n * 3 / 4). Order 6, N = 8: 243 (the thesis, one channel: 81).
-int registers_per_cluster(int order, int components);
-
-// Clusters that fit one pass: floor(budget / registers_per_cluster); at least 1 is needed
-// (throws std::invalid_argument naming the budget and the per-cluster cost otherwise).
-int clusters_per_pass(int register_budget, int order, int components);
-
 struct SuperClusters {
   std::vector<std::vector<std::uint32_t>> passes;  // cluster ids of each pass
   // pass_of[k]: the pass holding cluster k. Filled by the strategies; see pass_of_clusters().

@@ -23,7 +23,7 @@ struct SuperClusterInput {
   std::span<const std::uint32_t> cluster_of;   // cluster of each vertex, < cluster_count
   std::span<const TriangleIndices> triangles;  // vertex indices, < cluster_of.size()
   int cluster_count = 0;                       // >= 1; clusters without vertices are allowed
-  int per_pass = 1;                            // clusters per pass (clusters_per_pass()), >= 1
+  int per_pass = 1;                            // clusters per pass (render::pass_capacity), >= 1
 };
 
 // Throws std::invalid_argument naming the offending field and the fix.

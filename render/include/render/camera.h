@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include <optional>
+
 namespace render {
 
 struct Camera {
@@ -36,6 +38,18 @@ struct Camera {
 // with a small margin; near and far planes bracket the sphere.
 Camera frame_sphere(const Eigen::Vector3d& center, double radius, int width, int height,
                     double fov_y_degrees = 40.0);
+
+// Where a viewer wants the camera: the framed bounding sphere unless an eye, target or up is
+// given (each replaces the framed one).
+struct CameraPlacement {
+  std::optional<Eigen::Vector3d> eye, target, up;
+  double fov_y_degrees = 40.0;
+};
+
+// The camera `placement` asks for at width x height around the bounding sphere (center,
+// radius), clip planes fitted to the sphere; validated (std::invalid_argument, see validate).
+Camera place_camera(const CameraPlacement& placement, const Eigen::Vector3d& center, double radius,
+                    int width, int height);
 
 // Sets near/far so that they bracket the sphere as seen from camera.eye (keeps the rest).
 void fit_clip_planes(Camera& camera, const Eigen::Vector3d& center, double radius);

@@ -48,6 +48,9 @@ struct ConstantLayout {
 };
 
 ConstantLayout constant_layout(const cpca::CompressedSet& set);
+// The same for a set not compressed yet: SH `order`, glossy (transfer matrices) or diffuse,
+// `components` PCs per cluster.
+ConstantLayout constant_layout(int order, bool glossy, int components);
 
 // Packs a compressed set's matrices once, then computes every frame's constants.
 class ShadingConstants {
@@ -92,10 +95,5 @@ std::vector<Rgb> reference_vertex_radiance(const cpca::CompressedSet& set, const
 // Blocked GEMMs in parallel.
 void exit_vectors(const prt::TransferSet& transfer,
                   const Eigen::Ref<const prt::ShLighting>& lighting, std::vector<float>& out);
-
-// Radiance from exit vectors in the layout above (the CPU side of the uncompressed path).
-void shade_exit_vectors(const std::vector<float>& exit, int order, bool glossy,
-                        const meshes::Mesh& mesh, const Eigen::Vector3d& eye,
-                        std::vector<Rgb>& radiance);
 
 }  // namespace render

@@ -1,0 +1,39 @@
+// viewer/server.h: the HTTP side of `prtr view` (cpp-httplib, only in
+// view_server.cpp). Routes: GET / (the page), GET /api/info (what does not change, JSON),
+// GET /frame?... (a JPEG of the state the query describes, viewer/request.h; its statistics in
+// the X-Prtr-Frame header as JSON), GET /favicon.ico (204). Anything else is 404, another
+// method 405, a Host other than the listening address or localhost 421 (DNS rebinding); a bad
+// query is 400 with a one-line reason (viewer/request.h, parsed from the raw query); 503
+// while stopping. The port is bound exclusively: a second viewer on it fails to start. Request
+// threads parse, queue (viewer/queue.h), wait and encode; the calling thread renders, since the GL
+// context is current there.
+#pragma once
+
+#include "common/json.h"
+#include "viewer/request.h"
+#include "viewer/scene.h"
+
+#include <string>
+
+namespace viewer {
+
+struct ServerOptions {
+  std::string host = "127.0.0.1";
+  int port = 8080;  // 0: any free port (the printed URL says which)
+  int threads = 16;
+};
+
+struct ServedInfo {
+  common::Json info;  // /api/info
+  ViewLimits limits;
+  ViewState defaults;
+};
+
+// Prints "prtr view: http://HOST:PORT/" on stdout (flushed), then serves and renders until
+// SIGINT or SIGTERM, and returns normally. Throws std::runtime_error when it cannot listen.
+void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions& options);
+
+// The X-Prtr-Frame header of a frame: its state and timings.
+common::Json frame_header(const RenderedFrame& frame);
+
+}  // namespace viewer

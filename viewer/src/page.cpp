@@ -1,0 +1,246 @@
+#include "page.h"
+
+namespace viewer {
+
+// Drag rotates the environment (shift-drag, or the "camera" drag mode, orbits the camera),
+// the wheel zooms. One request at a time: input while a frame is on its way only marks the
+// view dirty, and the next request carries the newest state (the server coalesces too).
+// Latency per frame = queue + render + overlay + encode (the server's X-Prtr-Frame header)
+// + transfer (the rest of the time from sending the request to the decoded image).
+const char* view_page_html() {
+  return R"PAGE(<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>prtr view</title>
+<style>
+body { font: 13px sans-serif; margin: 0; display: flex; background: #222; color: #ddd; }
+#view { flex: none; padding: 8px; }
+#frame { display: block; background: #000; cursor: grab; user-select: none; }
+#panel { padding: 8px 12px; min-width: 300px; }
+fieldset { border: 1px solid #555; margin: 0 0 8px 0; }
+label { display: block; margin: 3px 0; }
+table { border-collapse: collapse; }
+td { padding: 1px 6px 1px 0; vertical-align: top; }
+td:first-child { color: #999; }
+#stat-error { color: #f77; }
+</style></head>
+<body>
+<div id="view"><img id="frame" alt="relit mesh" draggable="false"></div>
+<div id="panel">
+<fieldset><legend>Interaction</legend>
+<label><input type="radio" name="drag" value="env" id="drag-env" checked> drag rotates the environment</label>
+<label><input type="radio" name="drag" value="cam" id="drag-cam"> drag orbits the camera</label>
+<div>shift-drag does the other; the wheel zooms. <button id="reset">reset view</button></div>
+</fieldset>
+<fieldset><legend>Rendering</legend>
+<label>mode <select id="mode"></select></label>
+<label>super-clusters <select id="strategy"></select></label>
+<label>register budget <input id="budget" type="number" min="0" step="1" value="0"> (0: the context's)</label>
+<label>clusters per pass <input id="cpp" type="number" min="0" step="1" value="0"> (0: all that fit)</label>
+<label>size <select id="size"></select></label>
+</fieldset>
+<fieldset><legend>Lighting</legend>
+<label>probe <select id="probe"></select></label>
+<label>exposure <input id="exposure" type="range" min="-6" max="6" step="0.25" value="0"> <span id="exposure-value">0</span></label>
+</fieldset>
+<fieldset><legend>Overlays</legend>
+<label><input type="checkbox" id="overlay-overdraw"> overdraw (passes per triangle)</label>
+<label><input type="checkbox" id="overlay-clusters"> clusters</label>
+</fieldset>
+<fieldset><legend>Statistics</legend><table>
+<tr><td>render FPS</td><td id="stat-render-fps">-</td></tr>
+<tr><td>end-to-end FPS</td><td id="stat-e2e-fps">-</td></tr>
+<tr><td>latency (ms)</td><td id="stat-latency">-</td></tr>
+<tr><td>environment</td><td id="stat-env">-</td></tr>
+<tr><td>camera</td><td id="stat-cam">-</td></tr>
+<tr><td>mode</td><td id="stat-mode">-</td></tr>
+<tr><td>passes</td><td id="stat-passes">-</td></tr>
+<tr><td>average overdraw</td><td id="stat-overdraw">-</td></tr>
+<tr><td>clusters per pass</td><td id="stat-cpp">-</td></tr>
+<tr><td>register budget</td><td id="stat-budget">-</td></tr>
+<tr><td>clusters</td><td id="stat-clusters">-</td></tr>
+<tr><td>PCs</td><td id="stat-pcs">-</td></tr>
+<tr><td>order</td><td id="stat-order">-</td></tr>
+<tr><td>Average SE</td><td id="stat-se">-</td></tr>
+<tr><td>mesh</td><td id="stat-mesh">-</td></tr>
+<tr><td>renderer</td><td id="stat-gl">-</td></tr>
+<tr><td>llvmpipe threads</td><td id="stat-threads">-</td></tr>
+<tr><td>frames shown</td><td id="stat-frames">0</td></tr>
+<tr><td>error</td><td id="stat-error"></td></tr>
+</table></fieldset>
+</div>
+<script>
+"use strict";
+const $ = (id) => document.getElementById(id);
+const client = "c" + Math.random().toString(36).slice(2, 12);
+const urlParams = new URLSearchParams(location.search);
+const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch: 0, zoom: 1,
+  mode: "decoupled", strategy: "greedy-refine", budget: 0, cpp: 0, probe: 0, exposure: 0,
+  overlay: "none" };
+let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
+const log = [];          // per frame: {sent, shown, queue, render, overlay, encode, transfer}
+window.prtrLog = log;    // read by the measurement script
+
+const sizes = [[320, 237], [480, 355], [640, 474], [960, 710], [1280, 948]];
+function wrap(a) { a = ((a + 180) % 360 + 360) % 360 - 180; return Math.round(a * 100) / 100; }
+function clamp(x, lo, hi) { return Math.min(hi, Math.max(lo, x)); }
+function changed() { dirty = true; pump(); }
+
+function query() {
+  const q = new URLSearchParams({ client: client, seq: String(++seq) });
+  for (const [k, v] of Object.entries(state)) q.set(k, String(v));
+  return q.toString();
+}
+
+async function pump() {
+  if (inflight || !dirty) return;
+  dirty = false; inflight = true;
+  const sent = performance.now();
+  try {
+    const r = await fetch("/frame?" + query(), { cache: "no-store" });
+    if (!r.ok) { $("stat-error").textContent = r.status + ": " + (await r.text()); }
+    else {
+      const f = JSON.parse(r.headers.get("X-Prtr-Frame"));
+      const blob = await r.blob();
+      const url = URL.createObjectURL(blob);
+      const img = $("frame");
+      img.src = url;
+      await img.decode();
+      if (objectUrl) URL.revokeObjectURL(objectUrl);
+      objectUrl = url;
+      const now = performance.now();
+      const server = f.queue_ms + f.render_ms + f.overlay_ms + f.encode_ms;
+      log.push({ sent: sent, shown: now, queue: f.queue_ms, render: f.render_ms,
+                 frame: f.frame_ms, readback: f.readback_ms, overlay: f.overlay_ms, encode: f.encode_ms,
+                 transfer: Math.max(0, now - sent - server), total: now - sent });
+      if (log.length > 2000) log.splice(0, 1000);
+      showStats(f, now - sent, server);
+      $("stat-error").textContent = "";
+    }
+  } catch (e) { $("stat-error").textContent = String(e); }
+  inflight = false;
+  if (dirty) pump();
+}
+
+function showStats(f, total, server) {
+  shown += 1;
+  $("stat-frames").textContent = String(shown);
+  $("stat-render-fps").textContent = (1000 / Math.max(f.frame_ms, 1e-3)).toFixed(1) +
+      " (frame " + f.frame_ms.toFixed(1) + " ms)";
+  const now = performance.now();
+  const recent = log.filter((e) => now - e.shown < 2000);
+  const span = recent.length > 1 ? (recent[recent.length - 1].shown - recent[0].shown) : 0;
+  $("stat-e2e-fps").textContent = span > 0 ? ((recent.length - 1) * 1000 / span).toFixed(1) : "-";
+  $("stat-latency").textContent = total.toFixed(0) + " = queue " + f.queue_ms.toFixed(0) +
+      " + render " + f.render_ms.toFixed(0) + " + overlay " + f.overlay_ms.toFixed(0) +
+      " + encode " + f.encode_ms.toFixed(0) + " + transfer " + Math.max(0, total - server).toFixed(0);
+  $("stat-env").textContent = "yaw " + f.env_yaw.toFixed(1) + "°, pitch " + f.env_pitch.toFixed(1) + "°";
+  $("stat-cam").textContent = "yaw " + f.cam_yaw.toFixed(1) + "°, pitch " + f.cam_pitch.toFixed(1) +
+      "°, zoom " + f.zoom.toFixed(2);
+  $("stat-mode").textContent = f.mode + (f.mode === "multipass" || f.mode === "decoupled" ? " / " + f.strategy : "");
+  $("stat-passes").textContent = String(f.passes);
+  $("stat-overdraw").textContent = f.average_overdraw.toFixed(3);
+  $("stat-cpp").textContent = String(f.clusters_per_pass);
+  $("stat-budget").textContent = String(f.register_budget);
+}
+
+let drag = null;
+$("frame").addEventListener("mousedown", (e) => {
+  e.preventDefault();
+  const camera = $("drag-cam").checked !== e.shiftKey;
+  drag = { x: e.clientX, y: e.clientY, camera: camera };
+});
+window.addEventListener("mousemove", (e) => {
+  if (!drag) return;
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  drag.x = e.clientX; drag.y = e.clientY;
+  if (drag.camera) {
+    state.cam_yaw = wrap(state.cam_yaw - dx * 0.4);
+    state.cam_pitch = clamp(Math.round((state.cam_pitch + dy * 0.4) * 100) / 100, -89, 89);
+  } else {
+    state.env_yaw = wrap(state.env_yaw + dx * 0.4);
+    state.env_pitch = wrap(state.env_pitch + dy * 0.4);
+  }
+  changed();
+});
+window.addEventListener("mouseup", () => { drag = null; });
+$("frame").addEventListener("wheel", (e) => {
+  e.preventDefault();
+  state.zoom = clamp(Math.round(state.zoom * Math.exp(-e.deltaY * 0.001) * 1000) / 1000, 0.1, 20);
+  changed();
+}, { passive: false });
+$("reset").addEventListener("click", () => {
+  Object.assign(state, { env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch: 0, zoom: 1 });
+  changed();
+});
+
+function bindSelect(id, key, parse) {
+  $(id).addEventListener("change", () => { state[key] = parse($(id).value); changed(); });
+}
+bindSelect("mode", "mode", String);
+bindSelect("strategy", "strategy", String);
+bindSelect("probe", "probe", Number);
+for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"]])
+  $(id).addEventListener("change", () => {
+    state[key] = Math.max(0, Math.floor(Number($(id).value) || 0)); changed();
+  });
+$("size").addEventListener("change", () => {
+  const [w, h] = $("size").value.split("x").map(Number);
+  state.w = w; state.h = h; changed();
+});
+$("exposure").addEventListener("input", () => {
+  state.exposure = Number($("exposure").value);
+  $("exposure-value").textContent = state.exposure.toFixed(2);
+  changed();
+});
+function overlayChanged(id, other, name) {
+  $(id).addEventListener("change", () => {
+    if ($(id).checked) $(other).checked = false;
+    state.overlay = $(id).checked ? name : ($(other).checked ? state.overlay : "none");
+    changed();
+  });
+}
+overlayChanged("overlay-overdraw", "overlay-clusters", "overdraw");
+overlayChanged("overlay-clusters", "overlay-overdraw", "clusters");
+
+function fill(id, values, selected) {
+  const sel = $(id);
+  values.forEach((v, i) => {
+    const o = document.createElement("option");
+    o.value = Array.isArray(v) ? v[0] : v; o.textContent = Array.isArray(v) ? v[1] : v;
+    if (o.value === String(selected)) o.selected = true;
+    sel.appendChild(o);
+  });
+}
+
+async function start() {
+  const info = await (await fetch("/api/info")).json();
+  state.mode = info.defaults.mode; state.strategy = info.defaults.strategy;
+  state.probe = info.defaults.probe; state.exposure = info.defaults.exposure;
+  state.w = info.defaults.width; state.h = info.defaults.height;
+  if (urlParams.has("w")) state.w = Number(urlParams.get("w"));
+  if (urlParams.has("h")) state.h = Number(urlParams.get("h"));
+  if (urlParams.has("mode")) state.mode = urlParams.get("mode");
+  fill("mode", info.modes, state.mode);
+  fill("strategy", info.strategies, state.strategy);
+  fill("probe", info.probes.map((p, i) => [String(i), p]), state.probe);
+  const s = sizes.map(([w, h]) => [w + "x" + h, w + " × " + h]);
+  if (!sizes.some(([w, h]) => w === state.w && h === state.h))
+    s.unshift([state.w + "x" + state.h, state.w + " × " + state.h]);
+  fill("size", s, state.w + "x" + state.h);
+  $("exposure").value = String(state.exposure);
+  $("exposure-value").textContent = state.exposure.toFixed(2);
+  $("stat-clusters").textContent = String(info.clusters);
+  $("stat-pcs").textContent = String(info.pcs);
+  $("stat-order").textContent = String(info.order);
+  $("stat-se").textContent = info.average_se.toPrecision(4);
+  $("stat-mesh").textContent = info.mesh + " (" + info.vertices + " vertices)";
+  $("stat-gl").textContent = info.gl_renderer;
+  $("stat-threads").textContent = info.llvmpipe_threads + " (" + info.llvmpipe_threads_source + ")";
+  changed();
+}
+start().catch((e) => { $("stat-error").textContent = String(e); });
+</script>
+</body></html>
+)PAGE";
+}
+
+}  // namespace viewer

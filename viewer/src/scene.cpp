@@ -1,0 +1,237 @@
+#include "viewer/scene.h"
+
+#include "cpca/supercluster_strategy.h"
+#include "probes/load.h"
+#include "prt/projection.h"
+#include "prt/sh_rotation.h"
+#include "prt/transfer_file.h"
+#include "render/gl_context.h"
+#include "render/pass_grouping.h"
+#include "render/renderer.h"
+#include "render/shading.h"
+#include "viewer/encode.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <list>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <thread>
+
+namespace viewer {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
+
+// Renderers are large (per-pass vertex blocks, constants) and slow to build (grouping,
+// uploads), so a few are kept for switching back and forth, not one per combination.
+constexpr std::size_t kRenderersKept = 3;
+constexpr std::size_t kProbesKept = 2;  // texels for uploads; SH lighting is kept for all
+
+struct CachedRenderer {
+  std::string key;
+  std::unique_ptr<render::Renderer> renderer;
+  std::vector<std::uint8_t> pass_counts;  // per triangle, for the overdraw overlay
+  int probe = -1;                         // the probe its background texture holds
+};
+
+std::string renderer_key(const ViewState& s) {
+  const bool grouped = s.mode == render::Mode::kMultipass || s.mode == render::Mode::kDecoupled;
+  return std::string(render::mode_name(s.mode)) + "/" + (grouped ? s.strategy : "-") + "/" +
+         std::to_string(s.register_budget) + "/" + std::to_string(s.clusters_per_pass);
+}
+
+}  // namespace
+
+struct ViewScene::Impl {
+  explicit Impl(SceneInputs in) : inputs(std::move(in)) {}
+
+  CachedRenderer& renderer_for(const ViewState& state);
+  const prt::ShLighting& lighting_for(int probe);
+  const probes::Probe& probe_texels(int probe);
+  std::vector<std::uint8_t> pass_counts(const render::Renderer& r,
+                                        const std::optional<cpca::SuperClusters>& groups) const;
+  void add_overlay(RenderedFrame& frame, const CachedRenderer& cached,
+                   const render::Camera& camera) const;
+  void render_into(RenderedFrame& frame);
+
+  SceneInputs inputs;
+  render::GlContext context{inputs.gl};
+  SceneInfo info;
+  std::list<CachedRenderer> renderers;  // most recently used first
+  std::map<int, prt::ShLighting> lighting;
+  std::list<std::pair<int, probes::Probe>> probes_loaded;  // most recently used first
+  std::optional<prt::TransferSet> transfer;
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitY();
+};
+
+const probes::Probe& ViewScene::Impl::probe_texels(int probe) {
+  for (auto it = probes_loaded.begin(); it != probes_loaded.end(); ++it)
+    if (it->first == probe) {
+      probes_loaded.splice(probes_loaded.begin(), probes_loaded, it);
+      return probes_loaded.front().second;
+    }
+  probes_loaded.emplace_front(probe, probes::load_probe(inputs.probes.at(std::size_t(probe))));
+  if (probes_loaded.size() > kProbesKept) probes_loaded.pop_back();
+  return probes_loaded.front().second;
+}
+
+const prt::ShLighting& ViewScene::Impl::lighting_for(int probe) {
+  auto it = lighting.find(probe);
+  if (it == lighting.end())
+    it = lighting.emplace(probe, prt::project(probe_texels(probe), inputs.set->order)).first;
+  return it->second;
+}
+
+std::vector<std::uint8_t> ViewScene::Impl::pass_counts(
+    const render::Renderer& r, const std::optional<cpca::SuperClusters>& groups) const {
+  const meshes::Mesh& mesh = *inputs.mesh;
+  if (r.mode() != render::Mode::kMultipass)
+    return std::vector<std::uint8_t>(mesh.triangle_count(), 1);
+  const std::vector<cpca::TriangleIndices> triangles(mesh.triangles.begin(), mesh.triangles.end());
+  if (groups) return cpca::triangle_pass_counts(inputs.set->cluster_of, triangles, *groups);
+  // No grouping given: the renderer filled its passes in cluster order.
+  const cpca::SuperClusterInput input{inputs.set->cluster_of, triangles, inputs.set->cluster_count,
+                                      r.stats().clusters_per_pass};
+  return cpca::triangle_pass_counts(inputs.set->cluster_of, triangles,
+                                    cpca::group_clusters("order", input));
+}
+
+CachedRenderer& ViewScene::Impl::renderer_for(const ViewState& state) {
+  const std::string key = renderer_key(state);
+  for (auto it = renderers.begin(); it != renderers.end(); ++it)
+    if (it->key == key) {
+      renderers.splice(renderers.begin(), renderers, it);
+      return renderers.front();
+    }
+  // Free the least recently used one first: two bunny renderers at once cost memory.
+  if (renderers.size() >= kRenderersKept) renderers.pop_back();
+  render::RendererOptions ro;
+  ro.mode = state.mode;
+  ro.register_budget = state.register_budget;
+  ro.clusters_per_pass = state.clusters_per_pass;
+  std::optional<cpca::SuperClusters> groups;
+  if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
+    ro.groups = groups =
+        render::group_for_renderer(*inputs.mesh, *inputs.set, context, ro.register_budget,
+                                   ro.clusters_per_pass, state.strategy);
+  if (ro.mode == render::Mode::kUncompressed && !transfer)
+    transfer = prt::read_transfer(inputs.transfer);
+  const probes::Probe& probe = probe_texels(state.probe);
+  CachedRenderer cached;
+  cached.key = key;
+  cached.renderer = std::make_unique<render::Renderer>(
+      *inputs.mesh, inputs.set, ro.mode == render::Mode::kUncompressed ? &*transfer : nullptr,
+      &probe, ro);
+  cached.renderer->set_background(inputs.background);
+  cached.pass_counts = pass_counts(*cached.renderer, groups);
+  cached.probe = state.probe;
+  renderers.push_front(std::move(cached));
+  return renderers.front();
+}
+
+void ViewScene::Impl::add_overlay(RenderedFrame& frame, const CachedRenderer& cached,
+                                  const render::Camera& camera) const {
+  if (frame.state.overlay == Overlay::kNone) return;
+  const auto start = Clock::now();
+  render::PictureOptions po;
+  po.background = kOverlayTransparent;
+  if (frame.state.overlay == Overlay::kOverdraw)
+    frame.overlay = render::overdraw_picture(*inputs.mesh, camera, cached.pass_counts, po);
+  else
+    frame.overlay = render::cluster_picture(*inputs.mesh, camera, inputs.set->cluster_of, po);
+  frame.stats.overlay_ms = ms_since(start);
+}
+
+void ViewScene::Impl::render_into(RenderedFrame& frame) {
+  const ViewState& s = frame.state;
+  const auto start = Clock::now();
+  const auto setup_start = Clock::now();
+  CachedRenderer& cached = renderer_for(s);
+  const prt::ShLighting& sh = lighting_for(s.probe);
+  if (cached.probe != s.probe) {
+    cached.renderer->set_probe(&probe_texels(s.probe));
+    cached.probe = s.probe;
+  }
+  frame.stats.setup_ms = ms_since(setup_start);
+  const render::Camera camera = view_camera(inputs.camera, *inputs.mesh, s);
+  const render::FrameTiming t = cached.renderer->render(camera, sh, environment_rotation(axis, s));
+  const auto read_start = Clock::now();
+  frame.image = cached.renderer->read_image();
+  frame.stats.readback_ms = ms_since(read_start);
+  frame.stats.render_ms = ms_since(start);
+  frame.stats.frame_ms = t.total_ms;
+  frame.stats.cpu_ms = t.cpu_ms;
+  frame.stats.gl_ms = t.gl_ms;
+  const render::RenderStats& rs = cached.renderer->stats();
+  frame.stats.passes = rs.passes;
+  frame.stats.average_overdraw = rs.average_overdraw;
+  frame.stats.clusters_per_pass = rs.clusters_per_pass;
+  frame.stats.register_budget = rs.register_budget;
+  add_overlay(frame, cached, camera);
+}
+
+ViewScene::ViewScene(SceneInputs inputs) : impl_(std::make_unique<Impl>(std::move(inputs))) {
+  Impl& m = *impl_;
+  m.axis = m.inputs.axis;
+  const render::GlInfo gl = m.context.info();
+  m.info.gl_renderer = gl.renderer;
+  m.info.gl_version = gl.version;
+  m.info.default_register_budget = gl.default_register_budget();
+  m.info.registers_per_cluster = render::constant_layout(*m.inputs.set).registers_per_cluster();
+  // llvmpipe's rasteriser threads: LP_NUM_THREADS when set, else one per CPU.
+  const char* lp = std::getenv("LP_NUM_THREADS");
+  m.info.llvmpipe_threads = lp ? std::atoi(lp) : int(std::thread::hardware_concurrency());
+  m.info.llvmpipe_threads_source = lp ? "LP_NUM_THREADS" : "CPUs";
+}
+
+ViewScene::~ViewScene() = default;
+
+const SceneInfo& ViewScene::info() const {
+  return impl_->info;
+}
+
+std::shared_ptr<RenderedFrame> ViewScene::render(const ViewState& state) {
+  auto frame = std::make_shared<RenderedFrame>();
+  frame->state = state;
+  try {
+    impl_->render_into(*frame);
+  } catch (const std::invalid_argument& e) {  // a budget too small for one cluster, ...
+    frame->request_error = e.what();
+  } catch (const std::exception& e) {
+    frame->server_error = e.what();
+  }
+  if (!frame->request_error.empty() || !frame->server_error.empty()) frame->image = {};
+  return frame;
+}
+
+render::Camera view_camera(const render::CameraPlacement& placement, const meshes::Mesh& mesh,
+                           const ViewState& state) {
+  const Eigen::Vector3d centre = meshes::bounds(mesh).center().cast<double>();
+  double radius = 0.0;
+  for (const auto& p : mesh.positions)
+    radius = std::max(radius, (p.cast<double>() - centre).norm());
+  render::Camera c = render::place_camera(placement, centre, radius, state.width, state.height);
+  const Eigen::Vector3d forward = (c.target - c.eye).normalized();
+  const Eigen::Vector3d right = forward.cross(c.up).normalized();
+  const Eigen::Matrix3d orbit = prt::axis_angle(Eigen::Vector3d::UnitY(), radians(state.cam_yaw)) *
+                                prt::axis_angle(right, radians(state.cam_pitch));
+  c = render::rotated(c, orbit, c.target);
+  c.eye = c.target + (c.eye - c.target) / state.zoom;
+  render::fit_clip_planes(c, centre, radius);
+  return c;
+}
+
+Eigen::Matrix3d environment_rotation(const Eigen::Vector3d& axis, const ViewState& state) {
+  return prt::axis_angle(Eigen::Vector3d::UnitX(), radians(state.env_pitch)) *
+         prt::axis_angle(axis, radians(state.env_yaw));
+}
+
+}  // namespace viewer
