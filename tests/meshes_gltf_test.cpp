@@ -306,6 +306,74 @@ TEST(GltfErrors, HostileStructureIsRefusedBeforeAssimp) {
   expect_load_error(write_file("broken.gltf", R"({"asset":)"), "does not parse");
 }
 
+// A box as exporters write it: 24 vertices, four per face with the face's normal (NORMAL),
+// and 36 indices; with `normals` false the same without the NORMAL attribute.
+Scene split_normal_box(bool normals) {
+  const int faces[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                           {3, 7, 6, 2}, {0, 4, 7, 3}, {1, 2, 6, 5}};
+  const Vec3 face_normals[6] = {{0, 0, -1}, {0, 0, 1},  {0, -1, 0},
+                                {0, 1, 0},  {-1, 0, 0}, {1, 0, 0}};
+  const auto corner = [](int i) {
+    return Vec3(i == 1 || i == 2 || i == 5 || i == 6 ? 1.f : -1.f,
+                i == 2 || i == 3 || i >= 6 ? 1.f : -1.f, i >= 4 ? 1.f : -1.f);
+  };
+  Scene s;
+  for (const auto& f : faces)
+    for (int i : f) s.bin.append(reinterpret_cast<const char*>(corner(i).data()), 12);
+  for (const Vec3& n : face_normals)
+    for (int k = 0; k < 4; ++k) s.bin.append(reinterpret_cast<const char*>(n.data()), 12);
+  for (std::uint16_t f = 0; f < 6; ++f)
+    for (std::uint16_t i : {0, 1, 2, 0, 2, 3}) put(s.bin, std::uint16_t(4 * f + i));
+  json attributes = {{"POSITION", 0}};
+  if (normals) attributes["NORMAL"] = 1;
+  s.gltf = {{"asset", {{"version", "2.0"}}},
+            {"scene", 0},
+            {"scenes", {{{"nodes", {0}}}}},
+            {"nodes", {{{"mesh", 0}}}},
+            {"meshes", {{{"primitives", {{{"attributes", attributes}, {"indices", 2}}}}}}},
+            {"accessors",
+             {{{"bufferView", 0},
+               {"componentType", 5126},
+               {"count", 24},
+               {"type", "VEC3"},
+               {"min", {-1, -1, -1}},
+               {"max", {1, 1, 1}}},
+              {{"bufferView", 1}, {"componentType", 5126}, {"count", 24}, {"type", "VEC3"}},
+              {{"bufferView", 2}, {"componentType", 5123}, {"count", 36}, {"type", "SCALAR"}}}},
+            {"bufferViews",
+             {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 288}},
+              {{"buffer", 0}, {"byteOffset", 288}, {"byteLength", 288}},
+              {{"buffer", 0}, {"byteOffset", 576}, {"byteLength", 72}}}},
+            {"buffers", {{{"byteLength", s.bin.size()}}}}};
+  return s;
+}
+
+TEST(GltfNormals, SplitNormalBoxKeepsItsTwentyFourVertices) {
+  meshes::LoadReport report;
+  const Mesh m =
+      meshes::load_mesh(write_file("box.gltf", as_gltf(split_normal_box(true))), {}, &report);
+  EXPECT_TRUE(report.normals_from_file);
+  EXPECT_EQ(report.vertices_welded, 0u);
+  ASSERT_EQ(m.vertex_count(), 24u);
+  ASSERT_EQ(m.triangle_count(), 12u);
+  // Every corner's normal is its face's, as the file says: the box renders with hard edges.
+  for (const meshes::Triangle& t : m.triangles) {
+    const Vec3 face = (m.positions[t[1]] - m.positions[t[0]])
+                          .cross(m.positions[t[2]] - m.positions[t[0]])
+                          .normalized();
+    for (std::uint32_t v : t) EXPECT_GT(m.normals[v].dot(face), 1 - 1e-6);
+  }
+  // Without NORMAL the positions weld to 8, and a 30-degree crease angle splits them again.
+  meshes::LoadOptions auto_smooth;
+  auto_smooth.crease_angle_deg = 30;
+  const Mesh bare = meshes::load_mesh(write_file("bare_box.gltf", as_gltf(split_normal_box(false))),
+                                      auto_smooth, &report);
+  EXPECT_FALSE(report.normals_from_file);
+  EXPECT_EQ(report.vertices_welded, 16u);
+  EXPECT_EQ(report.vertices_split_at_creases, 16u);
+  EXPECT_EQ(bare.vertex_count(), 24u);
+}
+
 TEST(Weld, GroupsEqualPositionsDenselyInFirstOccurrenceOrder) {
   const std::vector<Vec3> p = {{1, 2, 3},       {0, 0, 0}, {1, 2, 3},
                                {-0.f, 0, -0.f}, {4, 5, 6}, {0, 0, 1e-30f}};

@@ -581,12 +581,20 @@ TEST(Frames, TangentsVaryContinuouslyOnAFineSphere) {
 
 // --- load.h: clean-up ------------------------------------------------------------------------
 
+// The clean-up with every edge smooth: for tests of welding on cubes, whose 90-degree edges
+// would otherwise be split again at the default crease angle (creases_test.cpp).
+meshes::LoadOptions all_smooth() {
+  meshes::LoadOptions o;
+  o.crease_angle_deg = 180;
+  return o;
+}
+
 TEST(Clean, WeldsDuplicatedCornersOfACube) {
   for (float scale : {1.f, 1000.f, 1e-3f}) {
     Mesh m = cube_of_separate_quads(scale);
     ASSERT_EQ(m.vertex_count(), 24u);
     meshes::LoadReport report;
-    meshes::clean_mesh(m, {}, &report);
+    meshes::clean_mesh(m, all_smooth(), &report);
     EXPECT_EQ(m.vertex_count(), 8u) << "scale " << scale;
     EXPECT_EQ(m.triangle_count(), 12u) << "scale " << scale;
     EXPECT_EQ(report.vertices_welded, 16u);
@@ -611,24 +619,24 @@ TEST(Clean, WeldToleranceIsRelativeToTheBoundingBox) {
     const float diag = std::sqrt(3.f) * scale;
     Mesh near = cube_of_separate_quads(scale);
     near.positions[4].x() += 1e-7f * diag;
-    meshes::clean_mesh(near);
+    meshes::clean_mesh(near, all_smooth());
     EXPECT_EQ(near.vertex_count(), 8u);
 
     Mesh far = cube_of_separate_quads(scale);
     far.positions[4].x() += 1e-5f * diag;
-    meshes::clean_mesh(far);
+    meshes::clean_mesh(far, all_smooth());
     EXPECT_EQ(far.vertex_count(), 9u);
   }
   // Negative tolerance: no welding at all.
   Mesh m = cube_of_separate_quads();
-  meshes::LoadOptions no_weld;
+  meshes::LoadOptions no_weld = all_smooth();
   no_weld.weld_tolerance = -1.0;
   meshes::clean_mesh(m, no_weld);
   EXPECT_EQ(m.vertex_count(), 24u);
   // Zero tolerance welds bit-identical positions only.
   Mesh exact = cube_of_separate_quads();
   exact.positions[4].x() = std::nextafter(exact.positions[4].x(), 1.f);
-  meshes::LoadOptions zero;
+  meshes::LoadOptions zero = all_smooth();
   zero.weld_tolerance = 0.0;
   meshes::clean_mesh(exact, zero);
   EXPECT_EQ(exact.vertex_count(), 9u);
@@ -716,7 +724,7 @@ TEST(Load, SameCubeFromEveryFormat) {
     SCOPED_TRACE(c.file);
     const fs::path path = write_file(c.file, c.content);
     meshes::LoadReport report;
-    const Mesh m = meshes::load_mesh(path, {}, &report);
+    const Mesh m = meshes::load_mesh(path, all_smooth(), &report);
     EXPECT_EQ(m.vertex_count(), 8u);
     EXPECT_EQ(m.triangle_count(), 12u);
     EXPECT_EQ(report.format, c.format);
@@ -772,7 +780,7 @@ TEST(Load, KeepsNonManifoldFaces) {
       "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\n"
       "f 1 2 3\nf 1 2 4\nf 1 2 5\n";
   meshes::LoadReport report;
-  const Mesh m = meshes::load_mesh(write_file("fin.obj", fin), {}, &report);
+  const Mesh m = meshes::load_mesh(write_file("fin.obj", fin), all_smooth(), &report);
   EXPECT_EQ(report.file_faces, 3u);
   EXPECT_EQ(m.triangle_count(), 3u);
   EXPECT_EQ(m.vertex_count(), 5u);

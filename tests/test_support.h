@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <csignal>
 #include <cstdint>
@@ -24,6 +25,33 @@
 #include <sys/resource.h>
 
 namespace test_support {
+
+// A cube of side 2 about the origin as OBJ text: 8 positions and 12 triangles, wound
+// counter-clockwise from outside. With `normals`, six 'vn' records (one per face, in the
+// order -Z +Z -Y +Y -X +X) and every corner written v//vn.
+inline std::string cube_obj(bool normals) {
+  std::string out =
+      "v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\n"
+      "v -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\n";
+  if (normals) out += "vn 0 0 -1\nvn 0 0 1\nvn 0 -1 0\nvn 0 1 0\nvn -1 0 0\nvn 1 0 0\n";
+  const int faces[6][4] = {{1, 4, 3, 2}, {5, 6, 7, 8}, {1, 2, 6, 5},
+                           {4, 8, 7, 3}, {1, 5, 8, 4}, {2, 3, 7, 6}};
+  for (int f = 0; f < 6; ++f) {
+    for (const auto& tri : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+      out += "f";
+      for (int c : tri) {
+        out += ' ';
+        out += std::to_string(faces[f][c]);
+        if (normals) {
+          out += "//";
+          out += std::to_string(f + 1);
+        }
+      }
+      out += "\n";
+    }
+  }
+  return out;
+}
 
 // A path in this suite's scratch directory (created on first use).
 inline std::filesystem::path scratch(const std::string& suite, const std::string& name) {

@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "common/json.h"
 #include "flag_checks.h"
+#include "mesh_flags.h"
 #include "meshes/load.h"
 #include "mpi_world.h"
 #include "pipeline/pipeline.h"
@@ -156,6 +157,7 @@ Runner add_bake_command(CLI::App& app) {
   struct Options {
     std::string mesh, output;
     BakeFlags flags;
+    MeshFlags mesh_flags;
     bool quiet = false, json = false;
     std::uint64_t block = 0;
     std::string shard;
@@ -166,6 +168,7 @@ Runner add_bake_command(CLI::App& app) {
   cmd->add_option("MESH", opt->mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("-o,--output", opt->output, "Transfer file to write (.prtx)")->required();
   add_bake_flags(cmd, opt->flags);
+  add_mesh_flags(cmd, opt->mesh_flags);
   cmd->add_option(
          "--block-vertices", opt->block,
          "Vertices computed and written per block (0: about 16 MiB of transfer); a bounce's "
@@ -183,7 +186,7 @@ Runner add_bake_command(CLI::App& app) {
     Options& o = *opt;
     check_outputs({{"-o", o.output}}, {{"MESH", o.mesh}});
     prt::BakeOptions options = resolve_bake_flags(o.flags);
-    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
     prt::BakeStats stats;
     const MpiWorld world = mpi_world();
     if (world.size > 1 && !o.shard.empty())

@@ -4,6 +4,7 @@
 #include "common/json.h"
 #include "compress_flags.h"
 #include "flag_checks.h"
+#include "mesh_flags.h"
 #include "mpi_world.h"
 
 #include "cpca/compress.h"
@@ -27,6 +28,7 @@ namespace {
 struct Options {
   std::string transfer, mesh, output;
   CompressFlags compress;
+  MeshFlags mesh_flags;
   bool quiet = false, json = false;
   std::uint64_t block_vertices = 0;  // 0: as many as fit kDefaultBlockBytes
 };
@@ -163,7 +165,7 @@ void mpi_compress(const Options& o, const cpca::CompressOptions& options) {
   const std::unique_ptr<cpca::Distribution> dist = mpi_distribution();
   const bool root = dist->first();
   try {
-    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
     const prt::MappedTransfer mapped(o.transfer);
     const prt::TransferSet& transfer = mapped.header();
     const cpca::RowBlocks blocks = row_blocks(mapped, o.block_vertices);
@@ -192,6 +194,7 @@ Runner add_compress_command(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", opt->output, "Compressed file to write (.prtc)")->required();
   add_compress_flags(cmd, opt->compress, CompressFlagSet::kCompress);
+  add_mesh_flags(cmd, opt->mesh_flags);
   cmd->add_flag("--json", opt->json, "Print the report as one JSON line instead");
   cmd->add_flag("-q,--quiet", opt->quiet, "No progress bar");
   cmd->add_option("--block-vertices", opt->block_vertices,
@@ -206,7 +209,7 @@ Runner add_compress_command(CLI::App& app) {
     const cpca::CompressOptions options = resolve_compress_flags(o.compress);
     check_sizes(options, o);
     if (mpi_world().size > 1) return mpi_compress(o, options);
-    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
     const prt::MappedTransfer mapped(o.transfer);
     const prt::TransferSet& transfer = mapped.header();
     const cpca::RowBlocks blocks = row_blocks(mapped, o.block_vertices);

@@ -2,6 +2,7 @@
 // with -o, write it (after --subdivide N rounds of Loop subdivision) as binary PLY.
 #include "commands.h"
 #include "flag_checks.h"
+#include "mesh_flags.h"
 
 #include "meshes/load.h"
 #include "meshes/subdivide.h"
@@ -29,6 +30,13 @@ void print_report(const meshes::LoadReport& report, const meshes::Mesh& mesh) {
       "faces dropped\n",
       report.vertices_welded, report.unreferenced_vertices_dropped,
       report.degenerate_faces_dropped);
+  if (report.normals_from_file) {
+    std::printf("normals     from the file (%zu vertices added for vertices with several)\n",
+                report.vertices_split_by_file_normals);
+  } else {
+    std::printf("normals     computed: %zu vertices split at creases\n",
+                report.vertices_split_at_creases);
+  }
   std::printf("result      %zu vertices, %zu triangles\n", mesh.vertex_count(),
               mesh.triangle_count());
   std::printf("bounds      min (%.6g, %.6g, %.6g)  max (%.6g, %.6g, %.6g)\n", b.min.x(), b.min.y(),
@@ -45,6 +53,7 @@ Runner add_mesh_command(CLI::App& app) {
     std::string path;
     double weld = meshes::LoadOptions{}.weld_tolerance;
     std::string normals = "angle";
+    MeshFlags mesh_flags;
     int subdivide = 0;
     std::string output;
   };
@@ -60,6 +69,7 @@ Runner add_mesh_command(CLI::App& app) {
   cmd->add_option("--normals", opt->normals, "Vertex normal weighting")
       ->check(CLI::IsMember({"angle", "area"}))
       ->capture_default_str();
+  add_mesh_flags(cmd, opt->mesh_flags);
   cmd->add_option("--subdivide", opt->subdivide,
                   "Rounds of Loop subdivision before writing -o (each: ~4x the vertices)")
       ->check(integer_in(0, 6));
@@ -73,7 +83,7 @@ Runner add_mesh_command(CLI::App& app) {
     if (!opt->output.empty() && std::filesystem::path(opt->output).extension() != ".ply") {
       throw UsageError("-o " + opt->output + ": the refined mesh is written as PLY; name it .ply");
     }
-    meshes::LoadOptions options;
+    meshes::LoadOptions options = load_options(opt->mesh_flags);
     options.weld_tolerance = opt->weld;
     options.normal_weighting =
         opt->normals == "area" ? meshes::NormalWeighting::kArea : meshes::NormalWeighting::kAngle;

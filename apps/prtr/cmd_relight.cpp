@@ -12,6 +12,7 @@
 #include "cpca/compressed_file.h"
 #include "flag_checks.h"
 #include "gl_flags.h"
+#include "mesh_flags.h"
 #include "meshes/load.h"
 #include "pipeline/pipeline.h"
 #include "probes/load.h"
@@ -23,6 +24,8 @@
 #include "render/image.h"
 #include "render/pass_grouping.h"
 #include "render/renderer.h"
+#include "render/supersample.h"
+#include "supersample_flag.h"
 #include "view_flags.h"
 
 #include <algorithm>
@@ -74,7 +77,9 @@ struct Options {
   ViewFlags view;
   CompressFlags compress;
   GlFlags gl;
+  MeshFlags mesh_flags;
   int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0, gif_width = 640;
+  int supersample = kDefaultSupersample;
   double degrees = 360.0;
   bool quiet = false, no_video = false;
 };
@@ -100,7 +105,9 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->capture_default_str();
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
   add_bake_flags(cmd, o.bake);
+  add_mesh_flags(cmd, o.mesh_flags);
   add_view_flags(cmd, o.view);
+  add_supersample_flag(cmd, o.supersample);
   add_gl_flags(cmd, o.gl);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--columns", o.columns, "Contact sheet columns")
@@ -176,16 +183,18 @@ std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::
   }
 }
 
+// frame_ms, gl_ms and cpu_ms are the renderer's (at the supersampled size); downsample_ms
+// is the anti-aliasing filter on the CPU after it, kept apart so FPS means what it always did.
 struct FrameTimes {
-  std::vector<double> frame_ms, gl_ms, cpu_ms;
+  std::vector<double> frame_ms, gl_ms, cpu_ms, downsample_ms;
   double seconds = 0;  // with EXR/PNG output
 };
 
 // What the frames leave besides their files: contact-sheet thumbnails and GIF frames.
 struct Previews {
   std::vector<render::Image> thumbnails;
-  std::vector<render::Rgb8Image> gif;  // every gif_stride-th frame
-  int gif_stride = 1;
+  std::vector<render::Rgb8Image> gif;  // every gif_stride-th frame, gif_width wide
+  int gif_stride = 1, gif_width = 0;
 };
 
 // GIF frames are kept in memory until the palette of the whole sequence is known: past this
@@ -198,7 +207,7 @@ int gif_width(const Options& o, const render::Camera& camera) {
 
 Previews make_previews(const Options& o, const render::Camera& camera) {
   Previews p;
-  const int width = gif_width(o, camera);
+  const int width = p.gif_width = gif_width(o, camera);
   const double height = std::max(1.0, std::round(double(camera.height) * width / camera.width));
   const double bytes = double(width) * height * 3.0 * double(o.frames);
   p.gif_stride = int(std::ceil(std::max(1.0, bytes / kGifBudgetBytes)));
@@ -209,12 +218,12 @@ Previews make_previews(const Options& o, const render::Camera& camera) {
 
 // One frame's files and previews, on a writer thread: every frame writes its own files and
 // its own slots of `previews`, so writers share nothing.
-void write_frame(const Options& o, int f, const render::Image& image, int gif_w,
-                 Previews& previews) {
+void write_frame(const Options& o, int f, const render::Image& image, Previews& previews) {
   render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
   render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
   previews.thumbnails[std::size_t(f)] = downscale(image, o.thumbnail);
   if (f % previews.gif_stride == 0) {
+    const int gif_w = previews.gif_width;
     const render::Image small = gif_w == image.width ? image : downscale(image, gif_w);
     previews.gif[std::size_t(f / previews.gif_stride)] = {
         small.width, small.height, render::tone_map_rgb8(small, o.view.exposure)};
@@ -222,12 +231,13 @@ void write_frame(const Options& o, int f, const render::Image& image, int gif_w,
 }
 
 // Writers for the frames: image encoding (EXR's ZIP, PNG's deflate) costs several times
-// the render, so it overlaps with rendering on every core; four frames at most wait.
+// the render, so it overlaps with rendering on every core.
 int writer_threads() {
   return std::clamp(int(std::thread::hardware_concurrency()), 2, 8);
 }
 
-// The sequence: EXR and PNG per frame, written while the next frames render.
+// The sequence: EXR and PNG per frame, written while the next frames render. `camera` is the
+// supersampled one; frames are box-filtered down to the requested size on the writers.
 FrameTimes render_frames(const Options& o, render::Renderer& renderer, const render::Camera& camera,
                          const prt::ShLighting& lighting, Previews& previews) {
   const Eigen::Vector3d axis = resolve_axis(o.view);
@@ -236,9 +246,10 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
   remove_old_frames(o.out);
   ProgressBar bar(o.quiet);
   FrameTimes times;
-  const int gif_w = gif_width(o, camera);
+  times.downsample_ms.resize(std::size_t(o.frames));
   const auto start = Clock::now();
-  common::WorkQueue writers(writer_threads(), 4);
+  // Two frames wait at most: a supersampled frame is 16 bytes a sample (77 MB at 2 x 2).
+  common::WorkQueue writers(writer_threads(), 2);
   for (int f = 0; f < o.frames; ++f) {
     bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
     const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
@@ -246,9 +257,13 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
     times.frame_ms.push_back(t.total_ms);
     times.gl_ms.push_back(t.gl_ms);
     times.cpu_ms.push_back(t.cpu_ms);
-    auto image = std::make_shared<const render::Image>(renderer.read_image());
-    writers.submit(
-        [&o, f, image, gif_w, &previews] { write_frame(o, f, *image, gif_w, previews); });
+    auto samples = std::make_shared<const render::Image>(renderer.read_image());
+    writers.submit([&o, f, samples, &times, &previews] {
+      const auto filter_start = Clock::now();
+      const render::Image image = render::box_downsample(*samples, o.supersample);
+      times.downsample_ms[std::size_t(f)] = 1000.0 * seconds_since(filter_start);
+      write_frame(o, f, image, previews);
+    });
   }
   writers.finish();
   bar.finish();
@@ -276,13 +291,18 @@ std::string make_animations(const Options& o, const Previews& previews) {
 void print_summary(const Options& o, const render::RenderStats& st, const render::Camera& camera,
                    const FrameTimes& t, const std::string& video, const fs::path& sheet,
                    double total_s) {
-  std::printf("render      %s, %d pass(es), average overdraw %.3f, %d x %d\n", o.mode.c_str(),
-              st.passes, st.average_overdraw, camera.width, camera.height);
+  std::printf(
+      "render      %s, %d pass(es), average overdraw %.3f, %d x %d (%d x %d samples per "
+      "pixel: %d x %d rendered)\n",
+      o.mode.c_str(), st.passes, st.average_overdraw, camera.width, camera.height, o.supersample,
+      o.supersample, camera.width * o.supersample, camera.height * o.supersample);
   std::printf(
       "frames      %d in %s: %.2f ms per frame median (%.1f FPS; CPU update %.2f ms, "
       "GL %.2f ms), %.2f s with EXR/PNG output\n",
       o.frames, o.out.c_str(), median(t.frame_ms), 1000.0 / median(t.frame_ms), median(t.cpu_ms),
       median(t.gl_ms), t.seconds);
+  std::printf("anti-alias  %.2f ms per frame median to box-filter %d x %d samples per pixel\n",
+              median(t.downsample_ms), o.supersample, o.supersample);
   std::printf("animation   %s\n", video.c_str());
   std::printf("total       %.1f s\n", total_s);
   std::printf("contact sheet: %s\n", sheet.string().c_str());
@@ -307,7 +327,7 @@ Runner add_relight_command(CLI::App& app) {
     resolve_background(o.view);
     const render::GlSelection gl = gl_selection(o.gl);
     check_sizes(bake, compress);
-    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+    const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
     if (std::size_t(compress.clusters) > mesh.vertex_count())
       throw UsageError("--clusters " + std::to_string(compress.clusters) + " exceeds the " +
                        std::to_string(mesh.vertex_count()) + " vertices of " + o.mesh);
@@ -320,7 +340,8 @@ Runner add_relight_command(CLI::App& app) {
     render::GlContext context(gl);
     const auto renderer = make_renderer(o, mesh, set, probe, context);
     Previews previews = make_previews(o, camera);
-    const FrameTimes times = render_frames(o, *renderer, camera, lighting, previews);
+    const FrameTimes times = render_frames(
+        o, *renderer, render::supersampled(camera, o.supersample), lighting, previews);
     const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
     render::write_png(sheet, tile(previews.thumbnails, o.columns), o.view.exposure);
     const std::string video = make_animations(o, previews);

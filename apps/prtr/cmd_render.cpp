@@ -5,7 +5,9 @@
 #include "common/json.h"
 #include "flag_checks.h"
 #include "gl_flags.h"
+#include "mesh_flags.h"
 #include "render/pass_grouping.h"
+#include "supersample_flag.h"
 #include "view_flags.h"
 
 #include "cpca/compressed_file.h"
@@ -21,6 +23,7 @@
 #include "render/renderer.h"
 #include "render/supersample.h"
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <numbers>
@@ -44,10 +47,11 @@ struct Options {
   std::string strategy = "order";
   ViewFlags view;
   GlFlags gl;
+  MeshFlags mesh_flags;
   double rotate_deg = 0.0, degrees_per_frame = 1.0;
   int register_budget = 0, clusters_per_pass = 0, frames = 20, warmup = 3;
   // The written image only: timing frames stay at --width x --height.
-  int supersample = 2;
+  int supersample = kDefaultSupersample;
   bool json = false, quiet = false, no_cull = false, no_reorder = false;
 };
 
@@ -57,12 +61,9 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("-o,--output", o.output, "EXR to write (linear RGB, alpha = coverage)")
       ->required();
   cmd->add_option("--png", o.png, "Also write a tone-mapped PNG");
-  cmd->add_option("--supersample", o.supersample,
-                  "Anti-aliasing of the written image: render N x N samples per pixel and "
-                  "box-filter (1: off)")
-      ->check(integer_in(1, 8))
-      ->capture_default_str();
+  add_supersample_flag(cmd, o.supersample);
   cmd->add_option("--mesh", o.mesh, "Mesh (default: the one the set was baked from)");
+  add_mesh_flags(cmd, o.mesh_flags);
   cmd->add_option("--mode", o.mode, "Rendering path")
       ->check(CLI::IsMember(render::mode_names()))
       ->capture_default_str();
@@ -122,10 +123,11 @@ render::RendererOptions renderer_options(const Options& o, const CLI::App* cmd) 
 meshes::Mesh load_checked_mesh(const Options& o, const cpca::CompressedSet& set) {
   const std::string mesh_path = o.mesh.empty() ? set.mesh_path : o.mesh;
   if (mesh_path.empty()) throw UsageError(o.compressed + " records no mesh path; pass --mesh MESH");
-  meshes::Mesh mesh = meshes::load_mesh(mesh_path);
+  meshes::Mesh mesh = meshes::load_mesh(mesh_path, load_options(o.mesh_flags));
   if (meshes::content_hash(mesh) != set.mesh_hash)
     throw std::runtime_error(o.compressed + " was baked from a different mesh than " + mesh_path +
-                             " (stale); bake and compress it again, or pass the right --mesh");
+                             " (stale); bake and compress it again, or pass the right --mesh "
+                             "(and the --crease-angle it was baked with)");
   return mesh;
 }
 
@@ -164,7 +166,7 @@ void add_work(Json& line, const std::vector<render::PassWork>& work) {
 }
 
 void print_report(const Options& o, const render::RenderStats& st,
-                  const render::TimingSummary& timing, double image_ms) {
+                  const render::TimingSummary& timing, double image_ms, double downsample_ms) {
   if (!o.quiet) {
     std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
                 o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
@@ -180,8 +182,10 @@ void print_report(const Options& o, const render::RenderStats& st,
         "frames\n",
         timing.fps, timing.frame_ms_median, timing.cpu_ms_median, timing.gl_ms_median,
         timing.frames);
-    std::printf("image       %d x %d samples per pixel, %.2f ms for the written frame\n",
-                o.supersample, o.supersample, image_ms);
+    std::printf(
+        "image       %d x %d samples per pixel, %.2f ms for the written frame, %.2f ms to "
+        "box-filter it\n",
+        o.supersample, o.supersample, image_ms, downsample_ms);
   }
   if (o.json) {
     Json line = {{"mode", o.mode},
@@ -197,6 +201,7 @@ void print_report(const Options& o, const render::RenderStats& st,
     add_work(line, st.pass_work);
     line["supersample"] = o.supersample;
     line["image_frame_ms"] = image_ms;
+    line["downsample_ms"] = downsample_ms;
     std::printf("%s\n", dump_json(line).c_str());
   }
 }
@@ -250,7 +255,12 @@ Runner add_render_command(CLI::App& app) {
     renderer->set_count_primitives(false);
     const render::Camera image_camera = render::supersampled(camera, o.supersample);
     const double image_ms = renderer->render(image_camera, lighting, rotation).total_ms;
-    const render::Image image = render::box_downsample(renderer->read_image(), o.supersample);
+    const render::Image samples = renderer->read_image();
+    const auto filter_start = std::chrono::steady_clock::now();
+    const render::Image image = render::box_downsample(samples, o.supersample);
+    const double downsample_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - filter_start)
+            .count();
     render::write_exr(o.output, image);
     if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
     const render::RenderStats& st = counted;
@@ -258,7 +268,7 @@ Runner add_render_command(CLI::App& app) {
       throw std::runtime_error("GL counted " + count_list(st.measured_triangles) +
                                " triangles per pass but the grouping predicts " +
                                count_list(st.triangles_per_pass) + " (a renderer bug)");
-    print_report(o, st, timing, image_ms);
+    print_report(o, st, timing, image_ms, downsample_ms);
   };
 }
 

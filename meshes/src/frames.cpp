@@ -75,6 +75,39 @@ void fall_back_where_inward(const Mesh& mesh, const std::vector<Vec3d>& area_sum
   }
 }
 
+// Stores the normals and a tangent field that follows the reference axis they avoid most.
+void fill_frames(const std::vector<Vec3d>& normals, const std::vector<bool>& has_normal,
+                 Mesh& mesh) {
+  const std::size_t n = normals.size();
+  // The reference axis the surface's normals avoid most.
+  std::array<double, 3> score = {0.0, 0.0, 0.0};
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!has_normal[v]) continue;
+    for (int k = 0; k < 3; ++k) {
+      const double c2 = normals[v][k] * normals[v][k];
+      const double c4 = c2 * c2;
+      score[k] += c4 * c4;
+    }
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (score[k] < score[axis]) axis = k;
+  }
+  const Vec3d reference = kAxes[axis];
+
+  mesh.normals.resize(n);
+  mesh.tangents.resize(n);
+  mesh.bitangents.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const Vec3d& nv = normals[v];
+    const Vec3d t = tangent_from_reference_d(nv, reference);
+    const Vec3d b = nv.cross(t);
+    mesh.normals[v] = nv.cast<float>();
+    mesh.tangents[v] = t.cast<float>();
+    mesh.bitangents[v] = b.cast<float>();
+  }
+}
+
 }  // namespace
 
 Vec3 tangent_from_reference(const Vec3& n, const Vec3& reference) {
@@ -128,33 +161,22 @@ void compute_frames(Mesh& mesh, NormalWeighting weighting) {
     }
   }
 
-  // The reference axis the surface's normals avoid most.
-  std::array<double, 3> score = {0.0, 0.0, 0.0};
-  for (std::size_t v = 0; v < n; ++v) {
-    if (!has_normal[v]) continue;
-    for (int k = 0; k < 3; ++k) {
-      const double c2 = normals[v][k] * normals[v][k];
-      const double c4 = c2 * c2;
-      score[k] += c4 * c4;
+  fill_frames(normals, has_normal, mesh);
+}
+
+void compute_tangents(Mesh& mesh) {
+  const std::size_t n = mesh.positions.size();
+  std::vector<Vec3d> normals(n, Vec3d::UnitY());
+  std::vector<bool> has_normal(n, false);
+  for (std::size_t v = 0; v < n && v < mesh.normals.size(); ++v) {
+    const Vec3d nv = mesh.normals[v].cast<double>();
+    const double len = nv.norm();
+    if (len > 0.0 && std::isfinite(len)) {
+      normals[v] = nv / len;
+      has_normal[v] = true;
     }
   }
-  int axis = 0;
-  for (int k = 1; k < 3; ++k) {
-    if (score[k] < score[axis]) axis = k;
-  }
-  const Vec3d reference = kAxes[axis];
-
-  mesh.normals.resize(n);
-  mesh.tangents.resize(n);
-  mesh.bitangents.resize(n);
-  for (std::size_t v = 0; v < n; ++v) {
-    const Vec3d& nv = normals[v];
-    const Vec3d t = tangent_from_reference_d(nv, reference);
-    const Vec3d b = nv.cross(t);
-    mesh.normals[v] = nv.cast<float>();
-    mesh.tangents[v] = t.cast<float>();
-    mesh.bitangents[v] = b.cast<float>();
-  }
+  fill_frames(normals, has_normal, mesh);
 }
 
 }  // namespace meshes

@@ -27,15 +27,18 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <mutex>
 #include <new>
 #include <sstream>
 #include <string_view>
 #include <system_error>
+#include <unordered_map>
 #include <vector>
 
 namespace meshes {
@@ -74,6 +77,11 @@ double diagonal_of(const Bounds& box) {
   return (box.max.cast<double>() - box.min.cast<double>()).norm();
 }
 
+// Adding +0 turns -0 into +0, so equal floats have equal bits.
+std::int32_t bits_of(float x) {
+  return std::bit_cast<std::int32_t>(x + 0.f);
+}
+
 // --- Reading ---------------------------------------------------------------------------------
 
 // Collects what a reader parses: positions and polygons as index lists, nothing else.
@@ -82,6 +90,9 @@ class CollectingImporter final : public omio::BaseImporter {
   std::vector<Vec3> positions;
   std::vector<std::uint32_t> corners;        // all faces' indices, concatenated
   std::vector<std::size_t> face_offsets{0};  // face f is corners[offsets[f], offsets[f+1])
+  // One per position when the file gives every vertex a normal, else empty.
+  std::vector<Vec3> normals;
+  std::size_t split_by_normals = 0;  // OBJ: vertices added for a 'v' used with several 'vn'
   // The first face that names a vertex that does not exist, if any.
   bool has_bad_face = false;
   std::size_t bad_face = 0;
@@ -209,11 +220,26 @@ struct CleanCounts {
   std::size_t welded = 0;
   std::size_t degenerate = 0;
   std::size_t unreferenced = 0;
+  std::size_t split_at_creases = 0;
 };
 
-// Welds, drops degenerate triangles and unused vertices, computes frames. `name` starts every
-// error message.
-CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& name) {
+// Keeps welded vertices apart where their normals differ: v merges into the first vertex of
+// its weld group whose normal is bit-identical to its own.
+void separate_by_normal(std::vector<std::uint32_t>& remap, const std::vector<Vec3>& normals) {
+  std::map<std::array<std::int64_t, 4>, std::uint32_t> first;
+  for (std::size_t v = 0; v < remap.size(); ++v) {
+    const Vec3& n = normals[v];
+    const std::array<std::int64_t, 4> key = {remap[v], bits_of(n.x()), bits_of(n.y()),
+                                             bits_of(n.z())};
+    remap[v] = first.try_emplace(key, std::uint32_t(v)).first->second;
+  }
+}
+
+// Welds, drops degenerate triangles and unused vertices, computes frames: from
+// `file_normals` (one per position) when given, else smooth within creases. `name` starts
+// every error message.
+CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& name,
+                  const std::vector<Vec3>* file_normals = nullptr) {
   // Structural problems are the caller's (in-memory meshes) or were reported by the loader.
   {
     Mesh bare;
@@ -226,7 +252,13 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
   const Bounds box = bounds(mesh);
   const double diagonal = diagonal_of(box);
 
-  const std::vector<std::uint32_t> remap = weld_map(mesh.positions, options.weld_tolerance, box);
+  std::vector<Vec3> unit_normals;
+  if (file_normals != nullptr) {
+    unit_normals.reserve(file_normals->size());
+    for (const Vec3& n : *file_normals) unit_normals.push_back(n.normalized());
+  }
+  std::vector<std::uint32_t> remap = weld_map(mesh.positions, options.weld_tolerance, box);
+  if (file_normals != nullptr) separate_by_normal(remap, unit_normals);
   for (std::size_t v = 0; v < remap.size(); ++v) {
     if (remap[v] != v) ++counts.welded;
   }
@@ -254,7 +286,7 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
   for (const Triangle& t : kept) {
     for (std::uint32_t v : t) new_index[v] = 0;
   }
-  std::vector<Vec3> positions;
+  std::vector<Vec3> positions, normals;
   positions.reserve(mesh.positions.size());
   for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
     if (new_index[v] == kUnused) {
@@ -263,6 +295,7 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
     }
     new_index[v] = static_cast<std::uint32_t>(positions.size());
     positions.push_back(mesh.positions[v]);
+    if (file_normals != nullptr) normals.push_back(unit_normals[v]);
   }
   for (Triangle& t : kept) {
     for (std::uint32_t& v : t) v = new_index[v];
@@ -281,10 +314,15 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
 
   mesh.positions = std::move(positions);
   mesh.triangles = std::move(kept);
-  mesh.normals.clear();
+  mesh.normals = std::move(normals);
   mesh.tangents.clear();
   mesh.bitangents.clear();
-  compute_frames(mesh, options.normal_weighting);
+  if (file_normals != nullptr) {
+    compute_tangents(mesh);
+  } else {
+    counts.split_at_creases = split_creases(mesh, options.crease_angle_deg);
+    compute_frames(mesh, options.normal_weighting);
+  }
   return counts;
 }
 
@@ -309,6 +347,7 @@ std::string read_all(const fs::path& path) {
 void deliver(detail::RawPolygons& raw, CollectingImporter& importer) {
   importer.positions = std::move(raw.positions);
   importer.face_offsets = std::move(raw.face_offsets);
+  importer.normals = std::move(raw.normals);
   importer.corners.reserve(raw.corners.size());
   for (const std::int64_t index : raw.corners) {
     if (index < 0 || std::uint64_t(index) >= importer.positions.size()) {
@@ -327,10 +366,75 @@ void deliver(detail::RawPolygons& raw, CollectingImporter& importer) {
   }
 }
 
+// True when every normal is finite and not zero, so that it has a direction.
+bool usable_normals(const std::vector<Vec3>& normals) {
+  return std::all_of(normals.begin(), normals.end(),
+                     [](const Vec3& n) { return n.allFinite() && n.squaredNorm() > 0.f; });
+}
+
+// OpenMesh's OBJ reader gives positions and faces only, so the normals come from our own
+// pass over the text, matched to the faces OpenMesh delivered (it skips some, see
+// LoadReport) by their vertex indices. When every corner has a normal, each (v, vn) pair
+// becomes a vertex: the first pair of a 'v' keeps its index, the others are appended.
+// Anything that does not match leaves the importer without normals, as for a file without.
+void attach_obj_normals(std::string_view text, CollectingImporter& importer) {
+  detail::ObjNormals obj;
+  detail::read_obj_normals(text, obj);
+  if (obj.normals.empty() || !usable_normals(obj.normals)) return;
+  const auto normal_count = std::int64_t(obj.normals.size());
+  std::vector<std::uint32_t> normal_of_corner(importer.corners.size());
+  const std::size_t obj_faces = obj.face_offsets.size() - 1;
+  std::size_t j = 0;
+  for (std::size_t f = 0; f < importer.face_count(); ++f) {
+    const std::size_t begin = importer.face_offsets[f];
+    const std::size_t k = importer.face_offsets[f + 1] - begin;
+    bool found = false;
+    for (; j < obj_faces && !found; ++j) {
+      const std::size_t ob = obj.face_offsets[j];
+      if (obj.face_offsets[j + 1] - ob != k) continue;
+      bool same = true;
+      for (std::size_t c = 0; c < k && same; ++c)
+        same = obj.vertices[ob + c] == std::int64_t(importer.corners[begin + c]);
+      if (!same) continue;
+      for (std::size_t c = 0; c < k; ++c) {
+        const std::int64_t n = obj.normal_of_corner[ob + c];
+        if (n < 0 || n >= normal_count) return;  // a corner without a (valid) normal
+        normal_of_corner[begin + c] = std::uint32_t(n);
+      }
+      found = true;
+    }
+    if (!found) return;
+  }
+  constexpr std::uint32_t kNone = 0xFFFFFFFFu;
+  const std::size_t vertex_count = importer.positions.size();
+  std::vector<std::uint32_t> first_normal(vertex_count, kNone);
+  std::unordered_map<std::uint64_t, std::uint32_t> extra;  // (v << 32 | vn) -> vertex
+  std::vector<Vec3> normals(vertex_count, Vec3::UnitY());  // unused vertices are dropped later
+  for (std::size_t c = 0; c < importer.corners.size(); ++c) {
+    std::uint32_t& v = importer.corners[c];
+    const std::uint32_t n = normal_of_corner[c];
+    if (first_normal[v] == kNone) {
+      first_normal[v] = n;
+      normals[v] = obj.normals[n];
+    } else if (first_normal[v] != n) {
+      const std::uint64_t key = (std::uint64_t(v) << 32) | n;
+      const auto [it, fresh] = extra.try_emplace(key, std::uint32_t(importer.positions.size()));
+      if (fresh) {
+        const Vec3 p = importer.positions[v];
+        importer.positions.push_back(p);
+        normals.push_back(obj.normals[n]);
+      }
+      v = it->second;
+    }
+  }
+  importer.split_by_normals = importer.positions.size() - vertex_count;
+  importer.normals = std::move(normals);
+}
+
 // Fills `importer` from the file; returns false when OpenMesh's reader gave up, throws what
 // `fail` makes for problems our own readers name.
 template <class Fail>
-bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
+bool parse(const fs::path& path, const std::string& format, std::uintmax_t size, bool want_normals,
            CollectingImporter& importer, const Fail& fail) {
   const std::lock_guard<std::mutex> lock(reader_mutex());
   omio::Options opt;
@@ -340,7 +444,8 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
                                                   : detail::check_gltf(path, size);
     if (!refused.empty()) throw fail(refused);
     detail::RawPolygons raw;
-    if (const std::string problem = detail::read_assimp(path, raw); !problem.empty()) {
+    if (const std::string problem = detail::read_assimp(path, raw, format != "3ds");
+        !problem.empty()) {
       throw fail(problem);
     }
     deliver(raw, importer);
@@ -377,7 +482,9 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
   // file's text from memory with every mtllib line blanked, and opens nothing itself.
   detail::blank_obj_material_libraries(text);
   std::istringstream in(text);
-  return omio::IOManager().read(in, ".obj", importer, opt);
+  if (!omio::IOManager().read(in, ".obj", importer, opt)) return false;
+  if (want_normals) attach_obj_normals(text, importer);
+  return true;
 }
 
 // File-system problems first, each with its own fix; returns the lower-case format.
@@ -410,8 +517,8 @@ std::string check_source(const fs::path& path, const Fail& fail) {
 // against the bytes that are left), so running out of memory here means the file itself is
 // too large.
 template <class Fail>
-void parse_checked(const fs::path& path, const std::string& format, CollectingImporter& importer,
-                   const Fail& fail) {
+void parse_checked(const fs::path& path, const std::string& format, bool want_normals,
+                   CollectingImporter& importer, const Fail& fail) {
   std::error_code ec;
   const std::uintmax_t size = fs::file_size(path, ec);
   if (ec) throw fail("cannot read its size (" + ec.message() + "); check permissions");
@@ -421,7 +528,7 @@ void parse_checked(const fs::path& path, const std::string& format, CollectingIm
   }
   bool parsed = false;
   try {
-    parsed = parse(path, format, size, importer, fail);
+    parsed = parse(path, format, size, want_normals, importer, fail);
   } catch (const std::bad_alloc&) {
     throw fail("too large to load into memory (" + std::to_string(size) +
                " bytes); free memory or simplify the mesh");
@@ -468,7 +575,7 @@ void check_parsed(const CollectingImporter& importer, const std::string& format,
 // Fan-triangulates: corners c0 ... c(k-1) give (c0, ci, ci+1). A face with fewer than three
 // corners has no area and counts as one degenerate triangle (returned).
 std::size_t triangulate(CollectingImporter& importer, Mesh& mesh, LoadReport& report) {
-  report.file_vertices = importer.positions.size();
+  report.file_vertices = importer.positions.size() - importer.split_by_normals;
   report.file_faces = importer.face_count();
   mesh.positions = std::move(importer.positions);
   std::size_t short_faces = 0;
@@ -503,6 +610,9 @@ void clean_mesh(Mesh& mesh, const LoadOptions& options, LoadReport* report) {
     report->degenerate_faces_dropped = counts.degenerate;
     report->vertices_welded = counts.welded;
     report->unreferenced_vertices_dropped = counts.unreferenced;
+    report->normals_from_file = false;
+    report->vertices_split_by_file_normals = 0;
+    report->vertices_split_at_creases = counts.split_at_creases;
   }
 }
 
@@ -513,15 +623,24 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
   };
   const std::string format = check_source(path, fail);
   CollectingImporter importer;
-  parse_checked(path, format, importer, fail);
+  parse_checked(path, format, options.file_normals, importer, fail);
   check_parsed(importer, format, fail);
 
   LoadReport local;
   local.path = name;
   local.format = format;
   Mesh mesh;
+  std::vector<Vec3> normals = std::move(importer.normals);
+  const bool normals_from_file = options.file_normals && !normals.empty() &&
+                                 normals.size() == importer.positions.size() &&
+                                 usable_normals(normals);
+  // Unusable normals after the OBJ pass split vertices by them: the copies sit at
+  // bit-identical positions, so welding merges them again.
+  local.vertices_split_by_file_normals = normals_from_file ? importer.split_by_normals : 0;
   const std::size_t short_faces = triangulate(importer, mesh, local);
-  const CleanCounts counts = clean(mesh, options, name);
+  const CleanCounts counts = clean(mesh, options, name, normals_from_file ? &normals : nullptr);
+  local.normals_from_file = normals_from_file;
+  local.vertices_split_at_creases = counts.split_at_creases;
   local.degenerate_faces_dropped = counts.degenerate + short_faces;
   local.vertices_welded = counts.welded;
   local.unreferenced_vertices_dropped = counts.unreferenced;

@@ -1,14 +1,17 @@
 // meshes/read_assimp.cpp: Assimp behind the interface of read_assimp.h.
 //
 // No post-processing is requested except Assimp's validation of its own data structure
-// (indices in range, counts consistent): triangulation, welding and normals are ours, so
-// every format goes through the same clean-up. Unsupported content is refused rather than
+// (indices in range, counts consistent): triangulation, welding and computed normals are
+// ours, so every format goes through the same clean-up. Normals the file itself stores
+// (glTF NORMAL) are passed on when every mesh has them. Unsupported content is refused rather than
 // read in a pose nobody asked for: bones (skinning) and anim meshes (morph targets).
 #include "read_assimp.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
+
+#include <Eigen/LU>
 
 #include <Eigen/Core>
 
@@ -50,12 +53,22 @@ bool has_polygons(const aiMesh& mesh) {
 
 // Appends `mesh` transformed by `world`; faces of fewer than three corners (points and lines
 // in a mixed mesh) are left out.
-void append(const aiMesh& mesh, const Eigen::Matrix4d& world, RawPolygons& out) {
+// Normals go through the inverse transpose of the node transform (non-uniform scale) and are
+// collected in `normals` while every mesh so far has them.
+void append(const aiMesh& mesh, const Eigen::Matrix4d& world, RawPolygons& out, bool& normals) {
   const std::int64_t base = std::int64_t(out.positions.size());
   for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
     const aiVector3D& p = mesh.mVertices[v];
     const Eigen::Vector4d q = world * Eigen::Vector4d(p.x, p.y, p.z, 1.0);
     out.positions.push_back((q.head<3>() / q.w()).cast<float>());
+  }
+  normals = normals && mesh.HasNormals();
+  if (normals) {
+    const Eigen::Matrix3d to_world = world.topLeftCorner<3, 3>().inverse().transpose();
+    for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+      const aiVector3D& n = mesh.mNormals[v];
+      out.normals.push_back((to_world * Eigen::Vector3d(n.x, n.y, n.z)).cast<float>());
+    }
   }
   for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
     const aiFace& face = mesh.mFaces[f];
@@ -66,7 +79,7 @@ void append(const aiMesh& mesh, const Eigen::Matrix4d& world, RawPolygons& out) 
 }
 
 // Walks the node tree with an explicit stack (its depth is the file's to choose).
-std::string flatten(const aiScene& scene, RawPolygons& out) {
+std::string flatten(const aiScene& scene, RawPolygons& out, bool normals) {
   std::vector<std::pair<const aiNode*, Eigen::Matrix4d>> stack;
   stack.emplace_back(scene.mRootNode, to_eigen(scene.mRootNode->mTransformation));
   std::uint64_t vertices = 0;
@@ -85,13 +98,14 @@ std::string flatten(const aiScene& scene, RawPolygons& out) {
         return "the flattened scene has over " + std::to_string(kMaxSceneVertices) +
                " vertices (meshes used by many nodes are copied per node); simplify it";
       }
-      append(mesh, world, out);
+      append(mesh, world, out, normals);
     }
     for (unsigned c = node->mNumChildren; c-- > 0;) {
       const aiNode* child = node->mChildren[c];
       stack.emplace_back(child, world * to_eigen(child->mTransformation));
     }
   }
+  if (!normals) out.normals.clear();
   if (!any_polygons) {
     return "no node holds triangles or polygons (only points or lines, or no meshes); export "
            "the surface with its faces";
@@ -101,7 +115,7 @@ std::string flatten(const aiScene& scene, RawPolygons& out) {
 
 }  // namespace
 
-std::string read_assimp(const std::filesystem::path& path, RawPolygons& out) {
+std::string read_assimp(const std::filesystem::path& path, RawPolygons& out, bool keep_normals) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
   if (scene == nullptr) {
@@ -117,7 +131,7 @@ std::string read_assimp(const std::filesystem::path& path, RawPolygons& out) {
       return problem;
     }
   }
-  return flatten(*scene, out);
+  return flatten(*scene, out, keep_normals);
 }
 
 }  // namespace meshes::detail

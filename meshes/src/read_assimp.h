@@ -3,8 +3,10 @@
 //
 // The scene is flattened into world space: every node's meshes are transformed by the
 // product of the transforms from the root down to it, and a mesh that several nodes use is
-// copied once per node. Only positions and polygons are taken; normals are recomputed by
-// the clean-up in load.cpp like those of every other format. 3DS is Z-up: Assimp's 3DS
+// copied once per node. Positions and polygons are taken, and with `keep_normals` the
+// vertex normals when every mesh has them (glTF's NORMAL; 3DS stores none, Assimp derives
+// them from smoothing groups, so for 3DS the caller asks for none and load.cpp computes
+// them like those of every other format without normals). 3DS is Z-up: Assimp's 3DS
 // importer rotates its root node to +Y-up, (x, y, z) -> (x, z, -y), which keeps the
 // handedness and the winding.
 #pragma once
@@ -20,6 +22,6 @@ namespace meshes::detail {
 inline constexpr std::uint64_t kMaxSceneVertices = std::uint64_t{1} << 26;
 
 // Returns an empty string on success, else the problem (without the path) and what to do.
-std::string read_assimp(const std::filesystem::path& path, RawPolygons& out);
+std::string read_assimp(const std::filesystem::path& path, RawPolygons& out, bool keep_normals);
 
 }  // namespace meshes::detail

@@ -460,7 +460,9 @@ struct PlyRoles {
   bool is_vertex = false;
   bool is_face = false;
   int xyz[3] = {-1, -1, -1};
+  int nxyz[3] = {-1, -1, -1};  // the vertex normal, kept only when all three are there
   int indices = -1;
+  bool has_normals() const { return nxyz[0] >= 0 && nxyz[1] >= 0 && nxyz[2] >= 0; }
 };
 
 PlyRoles ply_roles(const Element& e, bool saw_vertices) {
@@ -473,6 +475,9 @@ PlyRoles ply_roles(const Element& e, bool saw_vertices) {
       if (p.name == "x") r.xyz[0] = int(i);
       if (p.name == "y") r.xyz[1] = int(i);
       if (p.name == "z") r.xyz[2] = int(i);
+      if (p.name == "nx") r.nxyz[0] = int(i);
+      if (p.name == "ny") r.nxyz[1] = int(i);
+      if (p.name == "nz") r.nxyz[2] = int(i);
     }
     if (r.is_face && p.list && (p.name == "vertex_indices" || p.name == "vertex_index")) {
       r.indices = int(i);
@@ -511,10 +516,12 @@ std::string read_ply_list(Values& values, const Property& prop, Format format, b
 std::string read_ply_element(Values& values, const Element& e, const PlyRoles& roles, Format format,
                              RawPolygons& out) {
   if (roles.is_vertex) out.positions.reserve(e.count);
+  const bool normals = roles.is_vertex && roles.has_normals();
+  if (normals) out.normals.reserve(e.count);
   if (roles.is_face) out.face_offsets.reserve(out.face_offsets.size() + e.count);
   for (std::uint64_t r = 0; r < e.count; ++r) {
     const auto where = [&] { return "'" + e.name + "' record " + std::to_string(r) + ": "; };
-    float p[3] = {0, 0, 0};
+    float p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
     for (std::size_t i = 0; i < e.properties.size(); ++i) {
       const Property& prop = e.properties[i];
       std::string problem;
@@ -526,11 +533,13 @@ std::string read_ply_element(Values& values, const Element& e, const PlyRoles& r
         problem = values.next(prop.type, value);
         for (int k = 0; k < 3; ++k) {
           if (roles.is_vertex && roles.xyz[k] == int(i)) p[k] = float(value);
+          if (normals && roles.nxyz[k] == int(i)) n[k] = float(value);
         }
       }
       if (!problem.empty()) return where() + problem;
     }
     if (roles.is_vertex) out.positions.emplace_back(p[0], p[1], p[2]);
+    if (normals) out.normals.emplace_back(n[0], n[1], n[2]);
     if (roles.is_face && roles.indices >= 0) out.face_offsets.push_back(out.corners.size());
   }
   return {};
@@ -602,6 +611,45 @@ std::string check_obj_faces(std::string_view bytes) {
     }
   }
   return {};
+}
+
+void read_obj_normals(std::string_view bytes, ObjNormals& out) {
+  Lines lines(bytes);
+  std::string_view line;
+  std::int64_t vertex_records = 0;
+  bool normals_ok = true;
+  while (lines.next(line)) {
+    const std::vector<std::string_view> t = split(line);
+    if (t.empty()) continue;
+    if (t[0] == "v") {
+      ++vertex_records;
+    } else if (t[0] == "vn") {
+      std::optional<double> c[3];
+      for (int k = 0; k < 3; ++k)
+        c[k] = t.size() > std::size_t(k + 1) ? parse_real(t[k + 1]) : std::nullopt;
+      if (!c[0] || !c[1] || !c[2]) normals_ok = false;
+      if (normals_ok) out.normals.emplace_back(float(*c[0]), float(*c[1]), float(*c[2]));
+    } else if (t[0] == "f" && t.size() > 1) {
+      const auto normal_count = std::int64_t(out.normals.size());
+      for (std::size_t c = 1; c < t.size(); ++c) {
+        const std::string_view corner = t[c];
+        const std::size_t first = corner.find('/');
+        const std::int64_t v = parse_int<int>(corner.substr(0, first)).value_or(0);
+        out.vertices.push_back(v > 0 ? v - 1 : vertex_records + v);
+        std::int64_t n = -1;
+        if (first != std::string_view::npos) {
+          const std::size_t second = corner.find('/', first + 1);
+          if (second != std::string_view::npos) {
+            if (const auto k = parse_int<int>(corner.substr(second + 1)); k && *k != 0) {
+              n = *k > 0 ? *k - 1 : normal_count + *k;
+            }
+          }
+        }
+        out.normal_of_corner.push_back(n);
+      }
+      out.face_offsets.push_back(out.vertices.size());
+    }
+  }
 }
 
 void blank_obj_material_libraries(std::string& text) {

@@ -25,6 +25,8 @@ struct RawPolygons {
   // report the first bad face the same way for every format.
   std::vector<std::int64_t> corners;
   std::vector<std::size_t> face_offsets{0};  // face f is corners[offsets[f], offsets[f+1])
+  // One per position when the file gives every vertex a normal, else empty.
+  std::vector<Eigen::Vector3f> normals;
 };
 
 // Each returns an empty string on success, else the problem (without the path).
@@ -34,6 +36,21 @@ std::string read_ply(std::string_view bytes, RawPolygons& out);
 // Checks every 'f' record of an OBJ file before OpenMesh sees it: at least one corner, and
 // each corner v, v/vt, v//vn or v/vt/vn with v a non-zero integer that fits in an int.
 std::string check_obj_faces(std::string_view bytes);
+
+// What an OBJ file says about normals: its 'vn' records and, for every face in file order
+// (each 'f' record with at least one corner), its corners' vertex and normal indices,
+// resolved to 0-based (negative, relative indices counted back from the records read so
+// far). A corner without a normal index has normal -1.
+struct ObjNormals {
+  std::vector<Eigen::Vector3f> normals;
+  std::vector<std::int64_t> vertices;
+  std::vector<std::int64_t> normal_of_corner;
+  std::vector<std::size_t> face_offsets{0};
+};
+
+// Call after check_obj_faces accepted the text; malformed 'vn' records make `out.normals`
+// stop short (the caller then finds indices out of range and keeps no normals).
+void read_obj_normals(std::string_view bytes, ObjNormals& out);
 
 // Blanks (with spaces, keeping line numbers and offsets) every 'mtllib' statement of an OBJ
 // text, so that a reader given the text opens no material library.

@@ -197,12 +197,17 @@ CacheResult cached_bake(const meshes::Mesh& mesh, const std::string& mesh_name,
   const prt::Material& m = o.material;
   // The version names the baker's algorithm: bump it whenever the same inputs bake to other
   // numbers (v2: rays start on the face they leave through; v3: the view fit, Smith masking
-  // and views clamped to the horizon), so old entries are not reused.
-  key << "bake v3 mesh " << hex(meshes::content_hash(mesh)) << " kind " << int(o.kind) << " order "
-      << o.order << " samples " << o.samples << " bounces " << o.bounces << " seed " << o.seed
-      << " ray_offset " << o.ray_offset << " material " << int(m.kind) << ' ' << m.albedo.x() << ' '
-      << m.albedo.y() << ' ' << m.albedo.z() << ' ' << m.specular << ' ' << m.exponent << ' '
-      << m.roughness << ' ' << m.f0 << " masking " << int(m.masking) << " view " << int(o.view_fit);
+  // and views clamped to the horizon), so old entries are not reused. The mesh hash covers
+  // positions and triangles only; the normals (a file's own, or split at creases) go in too,
+  // since the same positions bake to other numbers under other normals (v4).
+  const std::uint64_t normals_hash =
+      common::fnv1a(mesh.normals.data(), mesh.normals.size() * sizeof(meshes::Vec3));
+  key << "bake v4 mesh " << hex(meshes::content_hash(mesh)) << " normals " << hex(normals_hash)
+      << " kind " << int(o.kind) << " order " << o.order << " samples " << o.samples << " bounces "
+      << o.bounces << " seed " << o.seed << " ray_offset " << o.ray_offset << " material "
+      << int(m.kind) << ' ' << m.albedo.x() << ' ' << m.albedo.y() << ' ' << m.albedo.z() << ' '
+      << m.specular << ' ' << m.exponent << ' ' << m.roughness << ' ' << m.f0 << " masking "
+      << int(m.masking) << " view " << int(o.view_fit);
   CacheResult r{cache_dir / ("bake-" + hex(hash_text(key.str())) + ".prtx"), false};
   sweep(cache_dir, reporter);
   if (fs::exists(r.path)) {

@@ -18,6 +18,10 @@ enum class NormalWeighting { kAngle, kArea };
 // Fills normals, tangents and bitangents. Vertices no face touches get an arbitrary frame.
 void compute_frames(Mesh& mesh, NormalWeighting weighting = NormalWeighting::kAngle);
 
+// Keeps the normals already in `mesh` (normalised; missing or zero ones become +Y) and fills
+// tangents and bitangents by the same rule: for normals a file supplies.
+void compute_tangents(Mesh& mesh);
+
 // An orthonormal tangent for normal n: the reference axis projected into the plane of n,
 // falling back to a second axis where n is (nearly) parallel to the reference.
 Vec3 tangent_from_reference(const Vec3& n, const Vec3& reference);

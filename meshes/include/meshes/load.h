@@ -6,8 +6,15 @@
 // Loading triangulates polygons (fan), drops degenerate faces (repeated index or zero area
 // after welding), welds positions closer than `weld_tolerance` times the bounding-box
 // diagonal, removes vertices no face uses, and computes the per-vertex frames.
+//
+// Normals (docs/ARCHITECTURE.md, "Normals and creases"): a file that stores a normal for
+// every vertex (OBJ vn on every face corner, glTF NORMAL, PLY nx ny nz) keeps them, and only
+// vertices that share position and normal are welded. Otherwise the normals are smooth
+// except across creases sharper than `crease_angle_deg`, where vertices are split
+// (meshes/creases.h).
 #pragma once
 
+#include "meshes/creases.h"
 #include "meshes/frames.h"
 #include "meshes/mesh.h"
 
@@ -25,6 +32,11 @@ struct LoadOptions {
   // value disables welding.
   double weld_tolerance = 1e-6;
   NormalWeighting normal_weighting = NormalWeighting::kAngle;
+  // Degrees between face normals beyond which an edge is hard, for files without normals
+  // (0: all flat, 180: all smooth).
+  double crease_angle_deg = kDefaultCreaseAngleDeg;
+  // false: ignore the file's normals and compute them as for a file without any.
+  bool file_normals = true;
 };
 
 // What loading found and changed; printed by `prtr mesh`.
@@ -47,6 +59,10 @@ struct LoadReport {
   std::size_t degenerate_faces_dropped = 0;
   std::size_t vertices_welded = 0;  // vertices merged into another
   std::size_t unreferenced_vertices_dropped = 0;
+  bool normals_from_file = false;
+  // OBJ: vertices added because one 'v' record is used with several normals ('vn').
+  std::size_t vertices_split_by_file_normals = 0;
+  std::size_t vertices_split_at_creases = 0;  // meshes/creases.h, files without normals
 };
 
 // Throws MeshError whose message starts with the path and says what to do, for: a missing or
@@ -64,10 +80,10 @@ Mesh load_mesh(const std::filesystem::path& path, const LoadOptions& options = {
                LoadReport* report = nullptr);
 
 // The same clean-up load_mesh applies, for meshes built in memory: weld, drop degenerate
-// and unreferenced, recompute frames. Counts go into `report` when given (file_vertices and
-// file_faces are then the mesh's counts before clean-up; path and format are left as they
-// are, and a non-empty path names the mesh in errors). Throws MeshError for out-of-range
-// indices, NaN/Inf positions, or no faces left.
+// and unreferenced, split creases, recompute frames (normals in `mesh` are not kept). Counts go
+// into `report` when given (file_vertices and file_faces are then the mesh's counts before
+// clean-up; path and format are left as they are, and a non-empty path names the mesh in errors).
+// Throws MeshError for out-of-range indices, NaN/Inf positions, or no faces left.
 void clean_mesh(Mesh& mesh, const LoadOptions& options = {}, LoadReport* report = nullptr);
 
 }  // namespace meshes

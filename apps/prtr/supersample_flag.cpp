@@ -1,0 +1,15 @@
+#include "supersample_flag.h"
+
+#include "flag_checks.h"
+
+namespace prtr_app {
+
+void add_supersample_flag(CLI::App* cmd, int& factor) {
+  cmd->add_option("--supersample", factor,
+                  "Anti-aliasing of the written frames: render N x N samples per pixel and "
+                  "box-filter (1: off)")
+      ->check(integer_in(1, 8))
+      ->capture_default_str();
+}
+
+}  // namespace prtr_app
