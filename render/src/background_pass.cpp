@@ -1,5 +1,6 @@
 #include "background_pass.h"
 
+#include "probes/cube_map.h"
 #include "render/gl_context.h"
 #include "render/glm_eigen.h"
 #include "render/shader_source.h"
@@ -51,25 +52,6 @@ Eigen::Vector3f bspline(const probes::Probe& probe, const Eigen::Vector3d& d) {
   return sum.cast<float>();
 }
 
-// The direction through texel centre (s, t) in [-1, 1]^2 of cube face `face` (+X, -X, +Y,
-// -Y, +Z, -Z), inverting the face selection of the OpenGL specification (table 8.19 in 4.6).
-Eigen::Vector3d cube_direction(int face, double sc, double tc) {
-  switch (face) {
-    case 0:
-      return {1, -tc, -sc};
-    case 1:
-      return {-1, -tc, sc};
-    case 2:
-      return {sc, 1, tc};
-    case 3:
-      return {sc, -1, -tc};
-    case 4:
-      return {sc, -tc, 1};
-    default:
-      return {-sc, -tc, -1};
-  }
-}
-
 // Face size: 3 cube texels per lat-long texel at a face's centre (2 / size radians against
 // 2 pi / width), so that one bilinear tap between the B-spline's samples stays within 2 %
 // of the B-spline itself at the 99th percentile where a probe is most magnified
@@ -95,7 +77,8 @@ void BackgroundPass::set_probe(const probes::Probe* probe) {
     tbb::parallel_for(0, size, [&](int t) {
       for (int s = 0; s < size; ++s) {
         const double sc = 2.0 * (s + 0.5) / size - 1.0, tc = 2.0 * (t + 0.5) / size - 1.0;
-        const Eigen::Vector3f c = bspline(*probe, cube_direction(face, sc, tc).normalized());
+        const Eigen::Vector3f c =
+            bspline(*probe, probes::CubeMap::face_direction(face, sc, tc).normalized());
         float* out = &texels[(std::size_t(t) * std::size_t(size) + std::size_t(s)) * 4];
         // Half floats end at 65504: clamp rather than store infinity.
         for (int k = 0; k < 3; ++k) out[k] = std::clamp(c[k], -65504.f, 65504.f);
