@@ -61,5 +61,4 @@ std::string constant_fragment_shader();  // uniform u_colour, alpha 1
 std::string background_vertex_shader();
 std::string background_fragment_shader();
 
-
 }  // namespace render
