@@ -13,6 +13,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -280,6 +281,54 @@ void probe_seeds(const fs::path& out, const fs::path& source, int width) {
   }
 }
 
+// The second hostile-input round's cases (docs/ROBUSTNESS.md has each with its answer).
+void hostile_seeds(const fs::path& out) {
+  const std::string triangle_buffer =
+      "data:application/octet-stream;base64,"
+      "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAQD//wAA";
+  const std::string tail =
+      R"("nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],)"
+      R"("buffers":[{"byteLength":48,"uri":")" +
+      triangle_buffer +
+      R"("}],"bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,)"
+      R"("byteLength":12}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,)"
+      R"("type":"VEC3"},{"bufferView":1,"componentType":5123,"count":)";
+  const std::string head = R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[)";
+  // Indices 0 1 2 1 65535 0 into 3 vertices, and the first face alone under 16 roots.
+  write(out / "mesh_gltf" / "index_65535.gltf", head + "0]}]," + tail + R"(6,"type":"SCALAR"}]})");
+  write(out / "mesh_gltf" / "roots.gltf",
+        head + "0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0]}]," + tail + R"(3,"type":"SCALAR"}]})");
+  std::string v, f;
+  put(v, std::uint16_t(3));
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(v, x);
+  put(f, std::uint16_t(1));
+  for (std::uint16_t i : {0, 1, 60000, 0}) put(f, i);
+  const std::string mesh = chunk(0x4100, chunk(0x4110, v) + chunk(0x4120, f));
+  write(out / "mesh_3ds" / "index_60000.3ds",
+        chunk(0x4D4D, chunk(0x3D3D, chunk(0x4000, std::string("q", 2) + mesh))));
+  write(out / "mesh_3ds" / "light_only.3ds",
+        chunk(0x4D4D, chunk(0x3D3D, chunk(0x4000, std::string("l", 2) +
+                                                      chunk(0x4600, std::string(12, '\0'))))));
+  write(out / "mesh_stl" / "two_coordinates.stl",
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 2\n"
+        "endloop\nendfacet\nendsolid t\n");
+  std::string nan_stl(80, ' ');
+  put(nan_stl, std::uint32_t(1));
+  for (float x : {0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, NAN, 0.f}) put(nan_stl, x);
+  put(nan_stl, std::uint16_t(0));
+  write(out / "mesh_stl" / "nan_binary.stl", nan_stl);
+  write(out / "mesh_obj" / "cr_only.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r");
+  const std::string ply_vertices =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\n";
+  write(out / "mesh_ply" / "zero_corners.ply",
+        ply_vertices +
+            "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n0 1 0\n0\n");
+  write(out / "mesh_ply" / "duplicate_x.ply",
+        ply_vertices + "property float x\nend_header\n0 0 0 0\n1 0 0 1\n0 1 0 0\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -304,6 +353,7 @@ int main(int argc, char** argv) {
         R"("count":12,"type":"SCALAR"}]})");
     write(out / "mesh_obj" / "mtllib.obj",
           "mtllib ../../../../../../../../dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    hostile_seeds(out);
     for (const char* name : {"cube", "asteroid-low"}) {
       const fs::path p = models / (std::string(name) + ".3ds");
       fs::create_directories(out / "mesh_3ds");

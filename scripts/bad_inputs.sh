@@ -88,6 +88,44 @@ add float_indices.gltf mesh "glTF line loop whose indices are the float position
 rm -f mtl.fifo && mkfifo mtl.fifo
 printf 'mtllib mtl.fifo\nmtllib ../../../../../../../../dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >mtllib.obj
 add mtllib.obj mesh "OBJ whose mtllib names a FIFO and ../../dev/zero (materials are never opened)"
+# A second hostile-input round: out-of-range indices, instancing, URIs, STL coordinates.
+tri_b64=AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAQD//wAA
+printf '%s' '{"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,'"$tri_b64"'"}],"bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":12}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}]}' >index_65535.gltf
+add index_65535.gltf mesh "glTF index 65535 into 3 vertices (Assimp dropped the face silently)"
+le f9 0 0 0 1 0 0 0 1 0 >tet.bin
+rm -f 't%65t.bin' && mkfifo 't%65t.bin'
+printf '%s"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],"bufferViews":[{"buffer":0,"byteLength":36}],"buffers":[{"byteLength":36,"uri":"t%%65t.bin"}]}' "$gltf_head" >escaped_uri.gltf
+add escaped_uri.gltf mesh "glTF buffer URI t%65t.bin: tet.bin is a file, t%65t.bin a FIFO (the checked file is the one read)"
+head -c 120024 /dev/zero >grid.bin
+perl -e 'print q({"asset":{"version":"2.0"},"scenes":[{"nodes":[), join(",", (0) x 2000),
+  q(]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":120024,"uri":"grid.bin"}],"bufferViews":[{"buffer":0,"byteLength":120024}],"accessors":[{"bufferView":0,"componentType":5126,"count":10002,"type":"VEC3","min":[0,0,0],"max":[0,0,0]}]})' >roots_2000.gltf
+add roots_2000.gltf mesh "glTF scene naming one 10,002-vertex root 2,000 times (20 M vertices from 126 KB)"
+perl -e 'print q({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[),
+  join(",", (q({"attributes":{"POSITION":0}})) x 70000),
+  q(]}],"buffers":[{"byteLength":36,"uri":"tet.bin"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})' >primitives_70k.gltf
+add primitives_70k.gltf mesh "glTF mesh repeating one primitive 70,000 times"
+{ le vV 0x4d4d 86; le vV 0x3d3d 80; le vV 0x4000 74; printf 'q\0'; le vV 0x4100 66
+  le vV 0x4110 44; le v 3; le f9 0 0 0 1 0 0 0 1 0; le vV 0x4120 16; le v 1; le v4 0 1 60000 7; } >index_60000.3ds
+add index_60000.3ds mesh "3DS face (0, 1, 60000) in a 3-vertex mesh (Assimp replaced the index)"
+{ le vV 0x4d4d 38; le vV 0x3d3d 32; le vV 0x4000 26; printf 'l\0'; le vV 0x4600 18; head -c 12 /dev/zero; } >light_only.3ds
+add light_only.3ds mesh "3DS holding only a light (Assimp leaks 1,132 bytes on it)"
+stl_facet() { printf 'solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex %s\nendloop\nendfacet\nendsolid t\n' "$1"; }
+stl_facet '1 2' >two_coordinates.stl
+add two_coordinates.stl mesh "ASCII STL 'vertex 1 2' (was left unset: a different mesh each run)"
+stl_facet 'abc 0 0' >word.stl
+add word.stl mesh "ASCII STL 'vertex abc 0 0'"
+stl_facet '0 0 inf' >inf.stl
+add inf.stl mesh "ASCII STL 'vertex 0 0 inf' (was read as 0)"
+{ head -c 80 /dev/zero; le V 1; le f12 0 0 1 0 0 0 1 0 0 0 nan 0; le v 0; } >nan_binary.stl
+add nan_binary.stl mesh "binary STL with a NaN vertex"
+printf 'v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r' >cr_only.obj
+add cr_only.obj mesh "OBJ with classic-Mac CR line ends"
+{ printf 'v '; head -c 2000000 /dev/zero | tr '\0' '1'; printf ' 0 0\n'; } >long_line.obj
+add long_line.obj mesh "OBJ 'v' line of 2 MB (a 300 MB one took 4.6 GB)"
+printf "${ply_header%%element face*}element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0\n" >zero_corners.ply
+add zero_corners.ply mesh "PLY whose only face has 0 corners"
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float x\nproperty float y\nproperty float z\nend_header\n' >duplicate_x.ply
+add duplicate_x.ply mesh "PLY declaring property x twice"
 { printf 'glTF'; le VVVV 2 1000 100 0x4e4f534a; } >short.glb
 add short.glb mesh "GLB whose header claims 1000 bytes, 20 present"
 { head -c 80 /dev/zero; le V 5; head -c 100 /dev/zero; } >short.stl
@@ -164,8 +202,8 @@ measure=()
   echo "Which reader does what: OFF and PLY are read by our own strict readers"
   echo "(\`meshes/src/read_strict.cpp\`; OpenMesh's OFF and PLY readers size buffers from"
   echo "unchecked counts and read values they never set after a parse error, which no guard in"
-  echo "front of them can fix). OBJ and STL still go through OpenMesh: OBJ behind a strict"
-  echo "pre-pass over its face lines, STL behind our own binary/ASCII decision by file size."
+  echo "front of them can fix), and so is STL (binary or ASCII, decided by the file's size). OBJ"
+  echo "still goes through OpenMesh, behind a strict pre-pass over its lines and face records."
   echo "glTF 2.0 and 3DS go through Assimp behind \`meshes/src/asset_guard.cpp\`, which checks"
   echo "every size, URI and nesting depth Assimp would trust (the table of guards is in"
   echo "docs/ARCHITECTURE.md, \"Mesh assets\"). Images go through OpenImageIO behind the checks above."

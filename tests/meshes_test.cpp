@@ -873,9 +873,10 @@ TEST(LoadErrors, BadContent) {
   // Garbage the PLY and OFF parsers reject outright.
   expect_load_error(write_file("garbage.ply", "this is not a mesh\n\x01\x02\x03"), "parse");
   expect_load_error(write_file("garbage.off", "hello world\n"), "parse");
-  // Garbage the OBJ and STL parsers skip line by line, leaving nothing.
+  // Garbage the OBJ parser skips line by line, leaving nothing; the STL reader stops at once.
   expect_load_error(write_file("garbage.obj", "hello world\nthis is garbage\n"), "no faces");
-  expect_load_error(write_file("garbage.stl", "hello world\nthis is garbage\n"), "no faces");
+  expect_load_error(write_file("garbage.stl", "hello world\nthis is garbage\n"),
+                    "does not start with 'solid'");
   expect_load_error(write_file("random.obj", std::string("\x7f\x00\xff\x13 binary junk", 17)),
                     "no faces");
   // Vertices only.

@@ -7,12 +7,15 @@
 #include "test_support.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <fstream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -260,6 +263,148 @@ TEST(HostileStl, TruncatedBinaryIsNamedAsSuch) {
   stl += bytes_of(std::uint32_t(5));
   stl += std::string(100, '\0');
   expect_mesh_error(write_file("short.stl", stl), "claims 5 triangles");
+}
+
+// Found by a second hostile-input round: each was read, with a wrong result or none.
+
+std::string ascii_stl_with_third_vertex(const std::string& third) {
+  return "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex " + third +
+         "\nendloop\nendfacet\nendsolid t\n";
+}
+
+TEST(HostileStl, AsciiCoordinatesMustAllBeFiniteNumbers) {
+  // OpenMesh's reader left an unparsable coordinate unset: another mesh hash on every run.
+  expect_mesh_error(write_file("two.stl", ascii_stl_with_third_vertex("1 2")),
+                    "line 6: 'vertex' needs three coordinates, found 2");
+  expect_mesh_error(write_file("word.stl", ascii_stl_with_third_vertex("abc 0 0")),
+                    "line 6: 'abc' is not a number");
+  // ... and read 'inf' and 'nan' as 0.
+  expect_mesh_error(write_file("inf.stl", ascii_stl_with_third_vertex("0 0 inf")), "'inf'");
+  expect_mesh_error(write_file("nan.stl", ascii_stl_with_third_vertex("0 0 nan")), "'nan'");
+  expect_mesh_error(write_file("big.stl", ascii_stl_with_third_vertex("0 0 1e39")), "'1e39'");
+  const meshes::Mesh m =
+      meshes::load_mesh(write_file("good.stl", ascii_stl_with_third_vertex("0 1 0")));
+  EXPECT_EQ(m.vertex_count(), 3u);
+  EXPECT_EQ(m.triangle_count(), 1u);
+}
+
+TEST(HostileStl, BinaryNanIsNamedByItsTriangle) {
+  // It was reported as "no faces, only 1 vertices".
+  std::string stl(80, '\0');
+  stl += bytes_of(std::uint32_t(2));
+  const float good[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  float bad[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+  bad[10] = std::numeric_limits<float>::quiet_NaN();
+  for (const float* t : {good, static_cast<const float*>(bad)})
+    stl += std::string(reinterpret_cast<const char*>(t), 48) + std::string(2, '\0');
+  expect_mesh_error(write_file("nan_binary.stl", stl), "triangle 1 has a non-finite coordinate");
+}
+
+TEST(HostileObj, ClassicMacLineEndsLoad) {
+  // CR-only line ends made the file one line: "no faces, only 1 vertices".
+  const meshes::Mesh m =
+      meshes::load_mesh(write_file("cr.obj", "v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r"));
+  EXPECT_EQ(m.triangle_count(), 1u);
+}
+
+TEST(HostileObj, OverlongLineIsRefused) {
+  // A 300 MB 'v' line peaked at 4.6 GB inside OpenMesh's reader; a line is bounded first.
+  std::string line = "v ";
+  line.append(2'000'000, '1');
+  line.append(" 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expect_mesh_error(write_file("long.obj", line), "line 1 has 2000006 bytes");
+}
+
+TEST(HostilePly, FacesWithoutThreeCornersAndRepeatedPropertiesAreNamed) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  // Reported as "all 0 triangle(s) are degenerate".
+  expect_mesh_error(write_file("zero_corners.ply", head + "0 0 0\n1 0 0\n0 1 0\n0\n"),
+                    "none of its 1 faces has three corners");
+  const std::string twice =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float x\n"
+      "property float y\nproperty float z\nend_header\n";
+  expect_mesh_error(write_file("twice.ply", twice), "property 'x' appears twice");
+}
+
+TEST(Hostile3ds, FaceIndexPastTheVertexListIsRefused) {
+  // Assimp replaced the index by the last vertex and kept the face.
+  std::string vertices = bytes_of(std::uint16_t(3));
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) vertices += bytes_of(x);
+  std::string faces = bytes_of(std::uint16_t(1));
+  for (std::uint16_t i : {0, 1, 60000, 7}) faces += bytes_of(i);
+  const std::string mesh = chunk(0x4100, chunk(0x4110, vertices) + chunk(0x4120, faces));
+  const std::string file = chunk(0x4D4D, chunk(0x3D3D, chunk(0x4000, std::string("q", 2) + mesh)));
+  expect_mesh_error(write_file("index.3ds", file), "names vertex 60000, but its mesh has 3");
+}
+
+// A glTF file of `body` (what follows the asset, without the closing brace).
+std::string gltf(const std::string& body) {
+  return R"({"asset":{"version":"2.0"},)" + body + "}";
+}
+
+// One triangle's positions (and six 16-bit indices) as a base64 buffer of 48 bytes.
+const std::string kTriangleBuffer =
+    "data:application/octet-stream;base64,"
+    "AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAQD//wAA";
+
+TEST(HostileGltf, IndexPastTheVerticesIsRefused) {
+  // Indices 0 1 2 1 65535 0 into 3 vertices: Assimp dropped the second face without a word.
+  const std::string file = gltf(
+      R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"buffers":[{"byteLength":48,"uri":")" +
+      kTriangleBuffer +
+      R"("}],"bufferViews":[{"buffer":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":12}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},{"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}])");
+  expect_mesh_error(write_file("index.gltf", file), "index 4 is 65535, but the primitive has 3");
+}
+
+std::string external_triangle_gltf(const std::string& uri, const std::string& scene_nodes = "0") {
+  return gltf(
+      R"("scenes":[{"nodes":[)" + scene_nodes +
+      R"(]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":36,"uri":")" +
+      uri +
+      R"("}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}])");
+}
+
+TEST(HostileGltf, PercentEscapedUriReadsTheFileThatWasChecked) {
+  // The guard checked tet.bin, Assimp opened "t%65t.bin" as written: a FIFO there blocked.
+  const fs::path dir = test_support::scratch("robustness", "escaped");
+  fs::create_directories(dir);
+  const float triangle[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::ofstream(dir / "tet.bin", std::ios::binary)
+      .write(reinterpret_cast<const char*>(triangle), sizeof triangle);
+  fs::remove(dir / "t%65t.bin");
+  ASSERT_EQ(::mkfifo((dir / "t%65t.bin").c_str(), 0600), 0);
+  std::ofstream(dir / "escaped.gltf") << external_triangle_gltf("t%65t.bin");
+  const auto start = std::chrono::steady_clock::now();
+  const meshes::Mesh m = meshes::load_mesh(dir / "escaped.gltf");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  EXPECT_EQ(m.triangle_count(), 1u);
+  // The decoded name itself a FIFO: refused, not opened.
+  fs::remove(dir / "fifo.bin");
+  ASSERT_EQ(::mkfifo((dir / "fifo.bin").c_str(), 0600), 0);
+  std::ofstream(dir / "fifo.gltf") << external_triangle_gltf("fif%6F.bin");
+  expect_mesh_error(dir / "fifo.gltf", "not a file beside the .gltf");
+}
+
+TEST(HostileGltf, InstancingIsBoundedFromTheCounts) {
+  // A scene naming one root 2,000 times and a mesh repeating one primitive 70,000 times
+  // took gigabytes before any count was checked.
+  const fs::path dir = test_support::scratch("robustness", "instancing");
+  fs::create_directories(dir);
+  std::ofstream(dir / "grid.bin", std::ios::binary) << std::string(120024, '\0');
+  std::string roots = "0";
+  for (int i = 1; i < 2000; ++i) roots += ",0";
+  std::ofstream(dir / "roots.gltf") << gltf(
+      R"("scenes":[{"nodes":[)" + roots +
+      R"(]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"buffers":[{"byteLength":120024,"uri":"grid.bin"}],"bufferViews":[{"buffer":0,"byteLength":120024}],"accessors":[{"bufferView":0,"componentType":5126,"count":10002,"type":"VEC3"}])");
+  expect_mesh_error(dir / "roots.gltf", "scene 0 places 20004000 vertices in 2000 nodes");
+  std::string primitives = R"({"attributes":{"POSITION":0}})";
+  for (int i = 1; i < 70000; ++i) primitives += R"(,{"attributes":{"POSITION":0}})";
+  std::ofstream(dir / "primitives.gltf") << gltf(
+      R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[)" + primitives +
+      R"(]}],"buffers":[{"byteLength":120024,"uri":"grid.bin"}],"bufferViews":[{"buffer":0,"byteLength":120024}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}])");
+  expect_mesh_error(dir / "primitives.gltf", "70000 mesh primitives");
 }
 
 // --- Extreme but finite coordinates -----------------------------------------------------------

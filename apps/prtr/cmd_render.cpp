@@ -128,6 +128,11 @@ meshes::Mesh load_checked_mesh(const Options& o, const cpca::CompressedSet& set)
     throw std::runtime_error(o.compressed + " was baked from a different mesh than " + mesh_path +
                              " (stale); bake and compress it again, or pass the right --mesh "
                              "(and the --crease-angle it was baked with)");
+  if (mesh.vertex_count() != set.vertex_count)
+    throw std::runtime_error(o.compressed + " holds " + std::to_string(set.vertex_count) +
+                             " vertices, but " + mesh_path + " has " +
+                             std::to_string(mesh.vertex_count()) +
+                             " with the same hash; the set is damaged, compress it again");
   return mesh;
 }
 
@@ -135,9 +140,10 @@ std::optional<prt::TransferSet> load_checked_transfer(const Options& o,
                                                       const cpca::CompressedSet& set) {
   if (o.transfer.empty()) return std::nullopt;
   prt::TransferSet transfer = prt::read_transfer(o.transfer);
-  if (transfer.mesh_hash != set.mesh_hash)
+  if (transfer.mesh_hash != set.mesh_hash || transfer.vertex_count != set.vertex_count)
     throw std::runtime_error(o.transfer + " and " + o.compressed +
-                             " come from different meshes; use the bake the set was made from");
+                             " come from different meshes (hash or vertex count differ); use "
+                             "the bake the set was made from");
   return transfer;
 }
 

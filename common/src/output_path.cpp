@@ -2,6 +2,7 @@
 #include "common/output_path.h"
 
 #include "common/atomic_file.h"
+#include "common/input_file.h"
 
 #include <sys/stat.h>
 
@@ -13,14 +14,7 @@ std::string output_target_problem(const fs::path& target) {
   struct stat st;
   // lstat: a symbolic link is judged as itself, not as what it points to.
   if (::lstat(target.c_str(), &st) != 0) return {};  // does not exist (or cannot be seen): fine
-  if (S_ISREG(st.st_mode)) return {};
-  if (S_ISDIR(st.st_mode)) return "is a directory";
-  if (S_ISLNK(st.st_mode)) return "is a symbolic link (not a regular file)";
-  if (S_ISCHR(st.st_mode)) return "is a character device (not a regular file)";
-  if (S_ISBLK(st.st_mode)) return "is a block device (not a regular file)";
-  if (S_ISFIFO(st.st_mode)) return "is a FIFO (not a regular file)";
-  if (S_ISSOCK(st.st_mode)) return "is a socket (not a regular file)";
-  return "is not a regular file";
+  return file_type_problem(unsigned(st.st_mode));
 }
 
 void check_output_target(const fs::path& target) {

@@ -5,6 +5,8 @@
 // claimed count can overflow a comparison.
 #include "asset_guard.h"
 
+#include "common/input_file.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -205,35 +207,57 @@ std::uint64_t uri_bytes(const std::string& uri, const fs::path& folder, const st
   return size;
 }
 
-std::vector<std::uint64_t> check_buffers(const json& root, const fs::path& folder,
-                                         std::optional<std::uint64_t> glb_bin) {
-  std::vector<std::uint64_t> lengths;
+// Where a buffer's bytes are, so that index values can be read: the .glb's binary chunk, a
+// base64 data URI, or a file beside the .gltf.
+struct BufferSource {
+  std::uint64_t length = 0;   // byteLength, checked against what the source holds
+  std::string_view data_uri;  // the whole URI for an embedded buffer
+  fs::path file;              // the checked (percent-decoded) path of an external buffer
+  bool glb_chunk = false;
+};
+
+std::vector<BufferSource> check_buffers(const json& root, const fs::path& folder,
+                                        const std::optional<std::string_view>& glb_bin,
+                                        ReferencedFiles& referenced) {
+  std::vector<BufferSource> sources;
   const json& buffers = array_at(root, "buffers");
   for (std::size_t b = 0; b < buffers.size(); ++b) {
     const std::string where = "buffer " + std::to_string(b);
     const json& buffer = buffers[b];
     if (!buffer.is_object()) refuse(where + " is not an object; the file is damaged");
-    const std::uint64_t length = count_of(buffer, "byteLength", where);
+    BufferSource source;
+    source.length = count_of(buffer, "byteLength", where);
     std::uint64_t available = 0;
     if (const auto uri = buffer.find("uri"); uri != buffer.end()) {
       if (!uri->is_string()) refuse(where + "'s uri is not a string; the file is damaged");
-      available = uri_bytes(uri->get<std::string>(), folder, where);
+      const std::string& text = uri->get_ref<const std::string&>();
+      available = uri_bytes(text, folder, where);
+      if (text.rfind("data:", 0) == 0) {
+        source.data_uri = text;
+      } else {
+        // Assimp asks for the URI as written; it is given the file checked here.
+        source.file = folder / percent_decoded(text, where);
+        referenced.push_back({text, source.file});
+      }
     } else if (b == 0 && glb_bin) {
-      available = *glb_bin;
+      available = glb_bin->size();
+      source.glb_chunk = true;
     } else {
       refuse(where + " has no uri and is not the .glb's binary chunk; the file is damaged");
     }
-    if (length > available) {
-      refuse(where + " claims " + std::to_string(length) + " bytes, but its data holds " +
+    if (source.length > available) {
+      refuse(where + " claims " + std::to_string(source.length) + " bytes, but its data holds " +
              std::to_string(available) + "; the file or its .bin is truncated");
     }
-    lengths.push_back(length);
+    sources.push_back(std::move(source));
   }
-  return lengths;
+  return sources;
 }
 
 std::vector<std::uint64_t> check_buffer_views(const json& root,
-                                              const std::vector<std::uint64_t>& buffers) {
+                                              const std::vector<BufferSource>& sources) {
+  std::vector<std::uint64_t> buffers;
+  for (const BufferSource& source : sources) buffers.push_back(source.length);
   std::vector<std::uint64_t> lengths;
   const json& views = array_at(root, "bufferViews");
   for (std::size_t v = 0; v < views.size(); ++v) {
@@ -412,8 +436,171 @@ void check_nodes(const json& root) {
   }
 }
 
+// Reads each buffer once, when an index accessor needs it.
+class BufferBytes {
+ public:
+  BufferBytes(const std::vector<BufferSource>& sources, std::string_view glb_bin)
+      : sources_(sources), glb_bin_(glb_bin), owned_(sources.size()) {}
+
+  std::string_view operator()(std::size_t b) {
+    const BufferSource& source = sources_[b];
+    if (source.glb_chunk) return glb_bin_;
+    std::optional<std::string>& bytes = owned_[b];
+    if (!bytes) bytes = source.file.empty() ? base64_payload(source.data_uri) : file_bytes(source);
+    // A file that shrank since it was measured is as damaged as a short one.
+    if (bytes->size() < source.length) {
+      refuse("buffer " + std::to_string(b) + " holds " + std::to_string(bytes->size()) +
+             " bytes, fewer than its byteLength " + std::to_string(source.length) +
+             " (did the file change while it was read?)");
+    }
+    return *bytes;
+  }
+
+ private:
+  static std::string base64_payload(std::string_view uri) {
+    const auto value = [](char c) -> std::uint32_t {
+      if (c >= 'A' && c <= 'Z') return std::uint32_t(c - 'A');
+      if (c >= 'a' && c <= 'z') return std::uint32_t(c - 'a' + 26);
+      if (c >= '0' && c <= '9') return std::uint32_t(c - '0' + 52);
+      return c == '+' ? 62u : 63u;  // '/'; characters were checked by data_uri_bytes
+    };
+    const std::string_view payload = uri.substr(uri.find(',') + 1);
+    std::string out;
+    out.reserve(payload.size() / 4 * 3);
+    for (std::size_t i = 0; i + 4 <= payload.size(); i += 4) {
+      std::uint32_t quad = 0;
+      int bytes = 3;
+      for (std::size_t k = 0; k < 4; ++k) {
+        if (payload[i + k] == '=') {
+          --bytes;
+          quad <<= 6;
+        } else {
+          quad = (quad << 6) | value(payload[i + k]);
+        }
+      }
+      for (int k = 0; k < bytes; ++k) out += char((quad >> (16 - 8 * k)) & 0xFF);
+    }
+    return out;
+  }
+
+  static std::string file_bytes(const BufferSource& source) {
+    common::InputFile in = common::open_input_file(source.file, kMaxAssetBytes);
+    if (in.file == nullptr) refuse("its buffer file " + source.file.string() + " " + in.problem);
+    std::string bytes(in.size, '\0');
+    bytes.resize(std::fread(bytes.data(), 1, bytes.size(), in.file));
+    return bytes;
+  }
+
+  const std::vector<BufferSource>& sources_;
+  std::string_view glb_bin_;
+  std::vector<std::optional<std::string>> owned_;
+};
+
+// Every index must name a vertex of its primitive: Assimp drops a face with an index out of
+// range without a word, which leaves a hole where the file is damaged.
+void check_index_values(const json& root, BufferBytes& buffers) {
+  const json& accessors = array_at(root, "accessors");
+  const json& views = array_at(root, "bufferViews");
+  const json& meshes = array_at(root, "meshes");
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    const json& primitives = array_at(meshes[m], "primitives");
+    for (std::size_t p = 0; p < primitives.size(); ++p) {
+      const json& primitive = primitives[p];
+      if (!primitive.contains("indices")) continue;
+      const std::string at = "mesh " + std::to_string(m) + " primitive " + std::to_string(p);
+      const std::uint64_t vertices =
+          accessors[primitive["attributes"]["POSITION"].get<std::size_t>()]["count"]
+              .get<std::uint64_t>();
+      const json& accessor = accessors[primitive["indices"].get<std::size_t>()];
+      const json& view = views[accessor["bufferView"].get<std::size_t>()];
+      const std::uint64_t component =
+          element_bytes(accessor["componentType"].get<std::uint64_t>(), "SCALAR");
+      const std::uint64_t step = std::max(count_of(view, "byteStride", at, 0), component);
+      const std::uint64_t count = accessor["count"].get<std::uint64_t>();
+      const std::string_view bytes = buffers(view["buffer"].get<std::size_t>());
+      // check_accessors proved the span lies inside the view and the view inside the buffer.
+      std::size_t offset =
+          count_of(view, "byteOffset", at, 0) + count_of(accessor, "byteOffset", at, 0);
+      for (std::uint64_t i = 0; i < count; ++i, offset += step) {
+        const std::uint64_t index = component == 1   ? std::uint8_t(bytes[offset])
+                                    : component == 2 ? le16(bytes, offset)
+                                                     : le32(bytes, offset);
+        if (index >= vertices) {
+          refuse(at + "'s index " + std::to_string(i) + " is " + std::to_string(index) +
+                 ", but the primitive has " + std::to_string(vertices) +
+                 " vertices; the file is damaged");
+        }
+      }
+    }
+  }
+}
+
+// Instancing multiplies: a scene may list one root many times, a mesh may repeat one
+// primitive, and Assimp builds a mesh per primitive and a node per use before anything is
+// flattened. So what the scene amounts to is bounded from the counts first. check_nodes has
+// proved the nodes a forest.
+void check_instancing(const json& root) {
+  const json& accessors = array_at(root, "accessors");
+  const json& meshes = array_at(root, "meshes");
+  const json& nodes = array_at(root, "nodes");
+  std::uint64_t primitives = 0;
+  std::vector<std::uint64_t> mesh_vertices(meshes.size(), 0);
+  for (std::size_t m = 0; m < meshes.size(); ++m) {
+    for (const json& primitive : array_at(meshes[m], "primitives")) {
+      ++primitives;
+      mesh_vertices[m] += accessors[primitive["attributes"]["POSITION"].get<std::size_t>()]["count"]
+                              .get<std::uint64_t>();
+    }
+  }
+  if (primitives > kMaxPrimitives) {
+    refuse("it has " + std::to_string(primitives) + " mesh primitives, over the limit of " +
+           std::to_string(kMaxPrimitives) + "; merge primitives that share a material");
+  }
+  // Subtree totals, children before parents: a breadth-first order from the roots, reversed.
+  std::vector<std::size_t> order;
+  std::vector<bool> is_child(nodes.size(), false);
+  for (const json& node : nodes)
+    for (const json& c : array_at(node, "children")) is_child[c.get<std::size_t>()] = true;
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    if (!is_child[n]) order.push_back(n);
+  for (std::size_t i = 0; i < order.size(); ++i)
+    for (const json& c : array_at(nodes[order[i]], "children"))
+      order.push_back(c.get<std::size_t>());
+  std::vector<std::uint64_t> vertices(nodes.size(), 0), count(nodes.size(), 1);
+  for (std::size_t i = order.size(); i-- > 0;) {
+    const std::size_t n = order[i];
+    if (nodes[n].contains("mesh"))
+      vertices[n] += mesh_vertices[nodes[n]["mesh"].get<std::size_t>()];
+    for (const json& c : array_at(nodes[n], "children")) {
+      vertices[n] += vertices[c.get<std::size_t>()];
+      count[n] += count[c.get<std::size_t>()];
+    }
+  }
+  const json& scenes = array_at(root, "scenes");
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    const std::string where = "scene " + std::to_string(s);
+    if (!scenes[s].is_object()) refuse(where + " is not an object; the file is damaged");
+    std::uint64_t scene_vertices = 0, scene_nodes = 0;
+    for (const json& r : array_at(scenes[s], "nodes")) {
+      if (!r.is_number_unsigned() || r.get<std::uint64_t>() >= nodes.size())
+        refuse(where + " names a root that is no node; the file is damaged");
+      // Each term is below 2^40 (counts fit their bytes) and there are fewer terms than
+      // bytes in the file, so the sums cannot wrap.
+      scene_vertices += vertices[r.get<std::size_t>()];
+      scene_nodes += count[r.get<std::size_t>()];
+    }
+    if (scene_vertices > kMaxSceneVertices || scene_nodes > kMaxSceneNodes) {
+      refuse(where + " places " + std::to_string(scene_vertices) + " vertices in " +
+             std::to_string(scene_nodes) + " nodes once every node and root is instanced, over " +
+             "the limits of " + std::to_string(kMaxSceneVertices) + " and " +
+             std::to_string(kMaxSceneNodes) +
+             " (a mesh used by many nodes is copied for each); simplify the scene");
+    }
+  }
+}
+
 void check_gltf_json(std::string_view text, const fs::path& folder,
-                     std::optional<std::uint64_t> glb_bin) {
+                     std::optional<std::string_view> glb_bin, ReferencedFiles& referenced) {
   check_json_depth(text);
   json root;
   try {
@@ -444,10 +631,13 @@ void check_gltf_json(std::string_view text, const fs::path& folder,
         "it has skins (bones), which are not supported; export the mesh in its bind pose "
         "without the armature");
   }
-  const std::vector<std::uint64_t> buffers = check_buffers(root, folder, glb_bin);
+  const std::vector<BufferSource> buffers = check_buffers(root, folder, glb_bin, referenced);
   check_accessors(root, check_buffer_views(root, buffers));
   check_meshes(root);
   check_nodes(root);
+  check_instancing(root);
+  BufferBytes bytes(buffers, glb_bin.value_or(std::string_view()));
+  check_index_values(root, bytes);
   const json& images = array_at(root, "images");
   for (std::size_t i = 0; i < images.size(); ++i) {
     if (images[i].is_object() && images[i].contains("uri") && images[i]["uri"].is_string()) {
@@ -462,7 +652,7 @@ constexpr std::uint32_t kGlbMagic = 0x46546C67;  // "glTF"
 constexpr std::uint32_t kChunkJson = 0x4E4F534A;
 constexpr std::uint32_t kChunkBin = 0x004E4942;
 
-void check_glb_bytes(std::string_view b, const fs::path& folder) {
+void check_glb_bytes(std::string_view b, const fs::path& folder, ReferencedFiles& referenced) {
   if (b.size() < 20 || le32(b, 0) != kGlbMagic) {
     refuse("it does not start with the binary glTF header ('glTF'); it is not a .glb file");
   }
@@ -474,7 +664,7 @@ void check_glb_bytes(std::string_view b, const fs::path& folder) {
            std::to_string(b.size()) + "; it is truncated or damaged, re-export it");
   }
   std::optional<std::string_view> json_chunk;
-  std::optional<std::uint64_t> bin;
+  std::optional<std::string_view> bin;
   for (std::size_t at = 12; at < b.size();) {
     if (b.size() - at < 8) refuse("it ends inside a chunk header; it is truncated");
     const std::uint64_t length = le32(b, at);
@@ -485,10 +675,10 @@ void check_glb_bytes(std::string_view b, const fs::path& folder) {
     }
     if (at == 12 && type != kChunkJson) refuse("its first chunk is not JSON; it is damaged");
     if (at == 12) json_chunk = b.substr(at + 8, length);
-    if (at > 12 && type == kChunkBin && !bin) bin = length;
+    if (at > 12 && type == kChunkBin && !bin) bin = b.substr(at + 8, length);
     at += 8 + length;
   }
-  check_gltf_json(*json_chunk, folder, bin);
+  check_gltf_json(*json_chunk, folder, bin, referenced);
 }
 
 // --- 3DS ------------------------------------------------------------------------------------
@@ -532,6 +722,35 @@ void check_3ds_list(std::string_view b, std::size_t at, std::uint64_t length) {
   }
 }
 
+// The vertices of the triangle mesh chunk (0x4100) at `at`: the sum of its vertex lists
+// (Assimp appends them). Malformed children are left to the walk, which refuses them.
+std::uint64_t trimesh_vertices(std::string_view b, std::size_t at, std::uint64_t length) {
+  std::uint64_t vertices = 0;
+  for (std::size_t child = at + 6; child + 8 <= at + length;) {
+    const std::uint64_t child_length = le32(b, child + 2);
+    if (child_length < 6 || child_length > at + length - child) break;
+    if (le16(b, child) == 0x4110) vertices += le16(b, child + 6);
+    child += child_length;
+  }
+  return vertices;
+}
+
+// Every face of a face list (0x4120, after check_3ds_list) must name a vertex of its mesh:
+// Assimp replaces an index out of range by the last vertex, which keeps a wrong triangle.
+void check_3ds_faces(std::string_view b, std::size_t at, std::uint64_t vertices) {
+  const std::uint64_t faces = le16(b, at + 6);
+  for (std::uint64_t f = 0; f < faces; ++f) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::uint64_t index = le16(b, at + 8 + 8 * f + 2 * c);
+      if (index >= vertices) {
+        refuse("face " + std::to_string(f) + " of the face list at byte " + std::to_string(at) +
+               " names vertex " + std::to_string(index) + ", but its mesh has " +
+               std::to_string(vertices) + " vertices; the file is damaged");
+      }
+    }
+  }
+}
+
 void check_3ds_bytes(std::string_view b) {
   if (b.size() < 6 || le16(b, 0) != 0x4D4D) {
     refuse("it does not start with a 3DS main chunk (0x4d4d); it is not a 3DS file");
@@ -543,6 +762,8 @@ void check_3ds_bytes(std::string_view b) {
   // The ends of the chunks enclosing `at`, innermost last.
   std::vector<std::size_t> open{le32(b, 2)};
   std::size_t at = 6;
+  std::uint64_t mesh_vertices = 0;  // of the innermost triangle mesh chunk
+  bool any_mesh = false;
   while (!open.empty()) {
     const std::size_t end = open.back();
     if (at >= end) {
@@ -564,6 +785,11 @@ void check_3ds_bytes(std::string_view b) {
     }
     if (id >= 0xB020 && id <= 0xB029) check_3ds_track(b, at, length);
     if (id == 0x4110 || id == 0x4120 || id == 0x4140) check_3ds_list(b, at, length);
+    if (id == 0x4100) {
+      mesh_vertices = trimesh_vertices(b, at, length);
+      any_mesh = true;
+    }
+    if (id == 0x4120) check_3ds_faces(b, at, mesh_vertices);
     if (!is_3ds_container(id)) {
       at += length;
       continue;
@@ -579,6 +805,12 @@ void check_3ds_bytes(std::string_view b) {
     }
     open.push_back(std::size_t(at + length));
     at = body;
+  }
+  // Assimp would refuse it too, but leaks what it read first (a light: 1,132 bytes).
+  if (!any_mesh) {
+    refuse(
+        "it holds no triangle mesh (no 0x4100 chunk; only lights, cameras or materials); "
+        "export the geometry");
   }
 }
 
@@ -598,12 +830,13 @@ std::string guarded(std::uint64_t size, const Check& check) {
 
 }  // namespace
 
-std::string check_gltf(const fs::path& path, std::uint64_t size) {
-  return guarded(size, [&] { check_gltf_json(read_all(path), path.parent_path(), std::nullopt); });
+std::string check_gltf(const fs::path& path, std::uint64_t size, ReferencedFiles& referenced) {
+  return guarded(
+      size, [&] { check_gltf_json(read_all(path), path.parent_path(), std::nullopt, referenced); });
 }
 
-std::string check_glb(const fs::path& path, std::uint64_t size) {
-  return guarded(size, [&] { check_glb_bytes(read_all(path), path.parent_path()); });
+std::string check_glb(const fs::path& path, std::uint64_t size, ReferencedFiles& referenced) {
+  return guarded(size, [&] { check_glb_bytes(read_all(path), path.parent_path(), referenced); });
 }
 
 std::string check_3ds(const fs::path& path, std::uint64_t size) {

@@ -439,12 +439,13 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
   const std::lock_guard<std::mutex> lock(reader_mutex());
   omio::Options opt;
   if (format == "3ds" || format == "gltf" || format == "glb") {
+    detail::ReferencedFiles referenced;
     const std::string refused = format == "3ds"   ? detail::check_3ds(path, size)
-                                : format == "glb" ? detail::check_glb(path, size)
-                                                  : detail::check_gltf(path, size);
+                                : format == "glb" ? detail::check_glb(path, size, referenced)
+                                                  : detail::check_gltf(path, size, referenced);
     if (!refused.empty()) throw fail(refused);
     detail::RawPolygons raw;
-    if (const std::string problem = detail::read_assimp(path, raw, format != "3ds");
+    if (const std::string problem = detail::read_assimp(path, referenced, raw, format != "3ds");
         !problem.empty()) {
       throw fail(problem);
     }
@@ -468,12 +469,21 @@ bool parse(const fs::path& path, const std::string& format, std::uintmax_t size,
     std::string problem;
     const bool binary = is_binary_stl(path, size, problem);
     if (!problem.empty()) throw fail(problem);
-    std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
-    if (binary) opt += omio::Options::Binary;
-    return omio::IOManager().read(in, ".stl", importer, opt);
+    const std::string bytes = read_all(path);
+    detail::RawPolygons raw;
+    problem = binary ? detail::read_stl_binary(bytes, raw) : detail::read_stl_ascii(bytes, raw);
+    if (!problem.empty()) {
+      throw fail(std::string("could not parse this file as ") + (binary ? "binary" : "ASCII") +
+                 " STL: " + problem);
+    }
+    deliver(raw, importer);
+    return true;
   }
   // OBJ: OpenMesh asserts on face corners without a vertex number, so they never reach it.
   std::string text = read_all(path);
+  if (const std::string problem = detail::normalise_obj_text(text); !problem.empty()) {
+    throw fail("could not parse this file as OBJ: " + problem);
+  }
   if (const std::string problem = detail::check_obj_faces(text); !problem.empty()) {
     throw fail("could not parse this file as OBJ: " + problem + "; fix the line");
   }
@@ -638,6 +648,10 @@ Mesh load_mesh(const fs::path& path, const LoadOptions& options, LoadReport* rep
   // bit-identical positions, so welding merges them again.
   local.vertices_split_by_file_normals = normals_from_file ? importer.split_by_normals : 0;
   const std::size_t short_faces = triangulate(importer, mesh, local);
+  if (mesh.triangles.empty()) {
+    throw fail("none of its " + std::to_string(short_faces) +
+               " faces has three corners (they are points or edges); export the surface");
+  }
   const CleanCounts counts = clean(mesh, options, name, normals_from_file ? &normals : nullptr);
   local.normals_from_file = normals_from_file;
   local.vertices_split_at_creases = counts.split_at_creases;

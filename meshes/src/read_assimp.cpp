@@ -7,8 +7,12 @@
 // read in a pose nobody asked for: bones (skinning) and anim meshes (morph targets).
 #include "read_assimp.h"
 
+#include "common/input_file.h"
+
+#include <assimp/DefaultIOStream.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 
 #include <Eigen/LU>
@@ -21,6 +25,59 @@
 namespace meshes::detail {
 
 namespace {
+
+namespace fs = std::filesystem;
+
+// A stream over a file opened by common::open_input_file (the constructor that takes a
+// FILE* is protected in Assimp).
+class CheckedStream : public Assimp::DefaultIOStream {
+ public:
+  CheckedStream(std::FILE* file, const std::string& name) : Assimp::DefaultIOStream(file, name) {}
+};
+
+// The only files Assimp may open: the asset and the files its guard checked, by the names
+// Assimp asks for (the folder joined with the URI as written). Anything else fails to open,
+// so a URI the guard did not see, or a file swapped for a FIFO since, reaches nothing.
+class CheckedFiles : public Assimp::IOSystem {
+ public:
+  CheckedFiles(const fs::path& asset, const ReferencedFiles& referenced) {
+    allowed_.push_back({asset.lexically_normal(), asset});
+    for (const ReferencedFile& r : referenced)
+      allowed_.push_back({(asset.parent_path() / r.uri).lexically_normal(), r.checked});
+  }
+
+  bool Exists(const char* name) const override { return resolve(name) != nullptr; }
+  char getOsSeparator() const override { return '/'; }
+
+  Assimp::IOStream* Open(const char* name, const char* mode) override {
+    const fs::path* path = resolve(name);
+    if (path == nullptr || std::string_view(mode).find_first_of("wa+") != std::string_view::npos) {
+      problem_ = std::string("it refers to '") + name + "', which was not checked";
+      return nullptr;
+    }
+    common::InputFile in = common::open_input_file(*path, kMaxAssetBytes);
+    if (in.file == nullptr) {
+      problem_ = path->string() + " " + in.problem;
+      return nullptr;
+    }
+    return new CheckedStream(in.release(), path->string());
+  }
+
+  void Close(Assimp::IOStream* stream) override { delete stream; }
+
+  const std::string& problem() const { return problem_; }
+
+ private:
+  const fs::path* resolve(const char* name) const {
+    const fs::path wanted = fs::path(name).lexically_normal();
+    for (const auto& [as_asked, checked] : allowed_)
+      if (as_asked == wanted) return &checked;
+    return nullptr;
+  }
+
+  std::vector<std::pair<fs::path, fs::path>> allowed_;
+  std::string problem_;
+};
 
 Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
   Eigen::Matrix4d out;
@@ -115,11 +172,15 @@ std::string flatten(const aiScene& scene, RawPolygons& out, bool normals) {
 
 }  // namespace
 
-std::string read_assimp(const std::filesystem::path& path, RawPolygons& out, bool keep_normals) {
+std::string read_assimp(const fs::path& path, const ReferencedFiles& referenced, RawPolygons& out,
+                        bool keep_normals) {
   Assimp::Importer importer;
+  auto* files = new CheckedFiles(path, referenced);
+  importer.SetIOHandler(files);  // the importer owns it from here
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_ValidateDataStructure);
   if (scene == nullptr) {
-    return std::string("Assimp could not read it (") + importer.GetErrorString() +
+    const std::string why = files->problem().empty() ? "" : ": " + files->problem();
+    return std::string("Assimp could not read it (") + importer.GetErrorString() + why +
            "); fix or re-export the file";
   }
   if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mRootNode == nullptr) {

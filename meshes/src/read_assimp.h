@@ -11,6 +11,7 @@
 // handedness and the winding.
 #pragma once
 
+#include "asset_guard.h"
 #include "read_strict.h"
 
 #include <filesystem>
@@ -18,10 +19,10 @@
 
 namespace meshes::detail {
 
-// Most vertices a flattened scene may have (instancing can multiply a small file's).
-inline constexpr std::uint64_t kMaxSceneVertices = std::uint64_t{1} << 26;
-
 // Returns an empty string on success, else the problem (without the path) and what to do.
-std::string read_assimp(const std::filesystem::path& path, RawPolygons& out, bool keep_normals);
+// Assimp may open `path` and the files in `referenced` (as the guard checked them), nothing
+// else, and each only if it is still a regular file within the size limit.
+std::string read_assimp(const std::filesystem::path& path, const ReferencedFiles& referenced,
+                        RawPolygons& out, bool keep_normals);
 
 }  // namespace meshes::detail

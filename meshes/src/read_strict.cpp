@@ -404,6 +404,12 @@ std::string read_ply_header_line(const std::vector<std::string_view>& t,
     } else {
       return "expected 'property <type> <name>' or 'property list ...'";
     }
+    for (const Property& q : elements.back().properties) {
+      if (q.name == p.name) {
+        return "property " + quote(p.name) + " appears twice in element " +
+               quote(elements.back().name) + "; the header is wrong";
+      }
+    }
     elements.back().properties.push_back(p);
   } else {
     return "unknown keyword " + quote(t[0]);
@@ -576,6 +582,99 @@ std::string read_ply(std::string_view bytes, RawPolygons& out) {
   return {};
 }
 
+// --- STL ------------------------------------------------------------------------------------
+
+namespace {
+
+// Each triangle becomes three new positions (STL shares none); the loader welds them.
+std::string add_stl_triangle(const float (&p)[3][3], std::uint64_t t, RawPolygons& out) {
+  for (const auto& corner : p) {
+    for (float x : corner) {
+      if (!std::isfinite(x)) {
+        return "triangle " + std::to_string(t) + " has a non-finite coordinate (" +
+               std::to_string(x) + "); fix or remove it";
+      }
+    }
+  }
+  for (const auto& corner : p) {
+    out.corners.push_back(std::int64_t(out.positions.size()));
+    out.positions.emplace_back(corner[0], corner[1], corner[2]);
+  }
+  out.face_offsets.push_back(out.corners.size());
+  return {};
+}
+
+}  // namespace
+
+std::string read_stl_binary(std::string_view bytes, RawPolygons& out) {
+  constexpr std::size_t kHeader = 84, kRecord = 50;
+  if (bytes.size() < kHeader) return "shorter than the 84-byte binary STL header";
+  std::uint32_t count = 0;
+  std::memcpy(&count, bytes.data() + 80, 4);
+  if ((bytes.size() - kHeader) / kRecord < count) {
+    return "its header claims " + std::to_string(count) + " triangles, more than its " +
+           std::to_string(bytes.size()) + " bytes hold";
+  }
+  out.positions.reserve(3 * std::size_t(count));
+  out.corners.reserve(3 * std::size_t(count));
+  out.face_offsets.reserve(count + 1);
+  for (std::uint32_t t = 0; t < count; ++t) {
+    float p[3][3];
+    // Little-endian floats after the facet normal, which is recomputed and so skipped.
+    std::memcpy(p, bytes.data() + kHeader + kRecord * t + 12, sizeof p);
+    if (std::string problem = add_stl_triangle(p, t, out); !problem.empty()) return problem;
+  }
+  return {};
+}
+
+// solid NAME / facet normal N N N / outer loop / vertex X Y Z (three) / endloop / endfacet /
+// endsolid. Keywords are checked in order, and every vertex needs three numbers: a reader that
+// skips what it cannot parse leaves coordinates unset.
+std::string read_stl_ascii(std::string_view bytes, RawPolygons& out) {
+  Lines lines(bytes);
+  std::string_view line;
+  std::vector<std::string_view> t;
+  const auto where = [&] { return "line " + std::to_string(lines.number()) + ": "; };
+  const auto next = [&] {
+    while (lines.next(line)) {
+      t = split(line);
+      if (!t.empty()) return true;
+    }
+    return false;
+  };
+  if (!next() || t[0] != "solid") return "it does not start with 'solid'; not an ASCII STL file";
+  std::uint64_t triangles = 0;
+  while (next()) {
+    if (t[0] == "endsolid") {
+      if (next() && t[0] == "solid") continue;  // several solids in one file
+      return triangles == 0 ? "it holds no facets" : std::string();
+    }
+    if (t[0] != "facet") return where() + "expected 'facet' or 'endsolid', found " + quote(t[0]);
+    if (!next() || t[0] != "outer" || t.size() != 2 || t[1] != "loop")
+      return where() + "expected 'outer loop' after 'facet'";
+    float p[3][3];
+    for (int c = 0; c < 3; ++c) {
+      if (!next() || t[0] != "vertex")
+        return where() + "expected the facet's vertex " + std::to_string(c + 1) + " of 3";
+      if (t.size() != 4) {
+        return where() + "'vertex' needs three coordinates, found " + std::to_string(t.size() - 1);
+      }
+      for (int k = 0; k < 3; ++k) {
+        const std::optional<double> x = parse_real(t[1 + k]);
+        if (!x) return where() + quote(t[1 + k]) + " is not a number";
+        if (!std::isfinite(float(*x))) return where() + quote(t[1 + k]) + " is not a finite float";
+        p[c][k] = float(*x);
+      }
+    }
+    if (!next() || t[0] != "endloop") return where() + "expected 'endloop' after three vertices";
+    if (!next() || t[0] != "endfacet") return where() + "expected 'endfacet'";
+    if (std::string problem = add_stl_triangle(p, triangles, out); !problem.empty())
+      return where() + problem;
+    ++triangles;
+  }
+  return "it ends without 'endsolid'; the file is truncated";
+}
+
 // --- OBJ pre-pass -----------------------------------------------------------------------------
 
 std::string check_obj_faces(std::string_view bytes) {
@@ -664,6 +763,24 @@ void blank_obj_material_libraries(std::string& text) {
     }
     start = end + 1;
   }
+}
+
+std::string normalise_obj_text(std::string& text) {
+  std::size_t line = 1, start = 0;
+  for (std::size_t i = 0; i <= text.size(); ++i) {
+    if (i < text.size() && text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'))
+      text[i] = '\n';
+    if (i == text.size() || text[i] == '\n') {
+      if (i - start > kMaxObjLineBytes) {
+        return "line " + std::to_string(line) + " has " + std::to_string(i - start) +
+               " bytes, over the limit of " + std::to_string(kMaxObjLineBytes) +
+               " for one OBJ statement; the file is damaged";
+      }
+      ++line;
+      start = i + 1;
+    }
+  }
+  return {};
 }
 
 }  // namespace meshes::detail

@@ -1,4 +1,4 @@
-// meshes/src/read_strict.h (private): our own readers for OFF and PLY, and a strict pre-pass
+// meshes/src/read_strict.h (private): our own readers for OFF, PLY and STL, and a strict pre-pass
 // over OBJ face lines.
 //
 // OpenMesh's OFF and PLY readers trust their headers: they size buffers from header counts
@@ -32,6 +32,16 @@ struct RawPolygons {
 // Each returns an empty string on success, else the problem (without the path).
 std::string read_off(std::string_view bytes, RawPolygons& out);
 std::string read_ply(std::string_view bytes, RawPolygons& out);
+// STL, binary (the caller decides which by the file's size) or ASCII. OpenMesh's ASCII reader
+// left a coordinate it could not parse unset, so a damaged file loaded differently each run.
+std::string read_stl_binary(std::string_view bytes, RawPolygons& out);
+std::string read_stl_ascii(std::string_view bytes, RawPolygons& out);
+
+// OpenMesh's OBJ reader splits lines at LF only, and copies a line into several token
+// buffers. So lone CRs (classic Mac line ends, which made a whole file one line) become LFs,
+// and a line longer than this limit is refused: a 300 MB 'v' line took 4.6 GB.
+inline constexpr std::size_t kMaxObjLineBytes = std::size_t{1} << 20;
+std::string normalise_obj_text(std::string& text);
 
 // Checks every 'f' record of an OBJ file before OpenMesh sees it: at least one corner, and
 // each corner v, v/vt, v//vn or v/vt/vn with v a non-zero integer that fits in an int.
