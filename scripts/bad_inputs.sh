@@ -174,6 +174,16 @@ if [[ -f good.prtx ]]; then
   cp good.prtx v1.prtx; printf '\x01' | dd of=v1.prtx bs=1 seek=8 conv=notrunc status=none
   add v1.prtx info "version-1 transfer file (the thesis's view projection)"
 fi
+# Outputs that would destroy an input or replace a special file (refused before any work).
+rm -f out.fifo && mkfifo out.fifo && ln -sf tet.obj link.prtx
+add tet.obj "bake -o tet.obj" "bake whose output is its own input mesh"
+add tet.obj "bake -o /dev/null" "bake whose output is /dev/null (a rename would replace the device)"
+add tet.obj "bake -o out.fifo" "bake whose output is a FIFO"
+add tet.obj "bake -o link.prtx" "bake whose output is a symbolic link"
+if [[ -f good.prtx ]]; then
+  add good.prtx "compress --mesh tet.obj -o good.prtx" "compress whose output is its input"
+  add good.prtx "compress --mesh tet.obj -o tet.obj" "compress whose output is the mesh"
+fi
 if [[ -f good.prtc ]]; then
   cp good.prtc payload.prtc; flip payload.prtc $(($(stat -c %s good.prtc) - 3)); add payload.prtc "info --verify" "compressed file with one payload byte flipped"
   head -c 150 good.prtc >cut.prtc; add cut.prtc info "compressed file cut after its header"
