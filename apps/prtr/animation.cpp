@@ -46,10 +46,10 @@ void commit(const fs::path& temporary, const fs::path& target) {
 VideoResult write_mp4(const fs::path& dir, int fps, const fs::path& output) {
   if (run_program({"ffmpeg", "-version"}, true) != 0) return VideoResult::kNoFfmpeg;
   const TemporaryFile temporary{temporary_for(output)};
-  const int status =
-      run_program({"ffmpeg", "-y", "-loglevel", "error", "-framerate", std::to_string(fps), "-i",
-                   (dir / "frame_%04d.png").string(), "-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2",
-                   "-pix_fmt", "yuv420p", "-f", "mp4", temporary.path.string()});
+  const int status = run_program({"ffmpeg", "-y", "-loglevel", "error", "-framerate",
+                                  std::to_string(fps), "-i", (dir / "frame_%04d.png").string(),
+                                  "-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2", "-pix_fmt", "yuv420p",
+                                  "-preset", "veryfast", "-f", "mp4", temporary.path.string()});
   if (status != 0) return VideoResult::kFailed;
   commit(temporary.path, output);
   return VideoResult::kWritten;

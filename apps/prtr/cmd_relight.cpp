@@ -82,6 +82,7 @@ struct Options {
   int supersample = kDefaultSupersample;
   double degrees = 360.0;
   bool quiet = false, no_video = false;
+  std::string exr_pixels = "half";
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
@@ -123,6 +124,11 @@ void add_flags(CLI::App* cmd, Options& o) {
                   "Width of the animated GIF preview in pixels (0: the frames' own size)")
       ->check(integer_in(0, 65535))
       ->capture_default_str();
+  cmd->add_option("--exr-pixels", o.exr_pixels,
+                  "EXR frames as half floats (PIZ, what renderers write for sequences) or "
+                  "32-bit floats (ZIP, as prtr render writes)")
+      ->check(CLI::IsMember({"half", "float"}))
+      ->capture_default_str();
   cmd->add_flag("--no-video", o.no_video, "Do not encode the MP4 (the GIF is always written)");
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
 }
@@ -150,19 +156,14 @@ void make_output_directory(const std::string& out) {
 fs::path bake_and_compress(const Options& o, const meshes::Mesh& mesh, const prt::BakeOptions& bake,
                            const cpca::CompressOptions& compress) {
   const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
-  const auto t_bake = Clock::now();
   const pipeline::Reporter reporter = stderr_reporter(o.quiet);
-  const pipeline::CacheResult transfer = pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
-  const double bake_s = seconds_since(t_bake);
-  const auto t_compress = Clock::now();
-  const pipeline::CompressCacheResult compressed =
-      pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
-  const double compress_s = seconds_since(t_compress);
-  std::printf("bake        %s %s (%.1f s)\n", transfer.hit ? "cached" : "baked",
-              transfer.path.string().c_str(), bake_s);
-  std::printf("compress    %s %s (%.1f s)\n", compressed.hit ? "cached" : "compressed",
-              compressed.path.string().c_str(), compress_s);
-  return compressed.path;
+  const pipeline::CachedPair r =
+      pipeline::cached_bake_and_compress(mesh, o.mesh, bake, compress, cache, reporter);
+  std::printf("bake        %s %s (%.1f s)\n", r.transfer.hit ? "cached" : "baked",
+              r.transfer.path.string().c_str(), r.bake_seconds);
+  std::printf("compress    %s %s (%.1f s)\n", r.compressed.hit ? "cached" : "compressed",
+              r.compressed.path.string().c_str(), r.compress_seconds);
+  return r.compressed.path;
 }
 
 std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::Mesh& mesh,
@@ -219,7 +220,8 @@ Previews make_previews(const Options& o, const render::Camera& camera) {
 // One frame's files and previews, on a writer thread: every frame writes its own files and
 // its own slots of `previews`, so writers share nothing.
 void write_frame(const Options& o, int f, const render::Image& image, Previews& previews) {
-  render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image);
+  render::write_exr(fs::path(o.out) / frame_name(f, "exr"), image,
+                    o.exr_pixels == "half" ? render::ExrPixels::kHalf : render::ExrPixels::kFloat);
   render::write_png(fs::path(o.out) / frame_name(f, "png"), image, o.view.exposure);
   previews.thumbnails[std::size_t(f)] = downscale(image, o.thumbnail);
   if (f % previews.gif_stride == 0) {
@@ -230,14 +232,15 @@ void write_frame(const Options& o, int f, const render::Image& image, Previews& 
   }
 }
 
-// Writers for the frames: image encoding (EXR's ZIP, PNG's deflate) costs several times
-// the render, so it overlaps with rendering on every core.
+// Writers for the frames: image encoding (EXR's PIZ or ZIP, PNG's deflate) costs about the
+// render's time, so it overlaps with rendering on every core.
 int writer_threads() {
   return std::clamp(int(std::thread::hardware_concurrency()), 2, 8);
 }
 
 // The sequence: EXR and PNG per frame, written while the next frames render. `camera` is the
-// supersampled one; frames are box-filtered down to the requested size on the writers.
+// supersampled one; each frame is box-filtered down to the requested size before it is
+// queued.
 FrameTimes render_frames(const Options& o, render::Renderer& renderer, const render::Camera& camera,
                          const prt::ShLighting& lighting, Previews& previews) {
   const Eigen::Vector3d axis = resolve_axis(o.view);
@@ -248,8 +251,10 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
   FrameTimes times;
   times.downsample_ms.resize(std::size_t(o.frames));
   const auto start = Clock::now();
-  // Two frames wait at most: a supersampled frame is 16 bytes a sample (77 MB at 2 x 2).
+  // Samples are read into one buffer and box-filtered here, so only frames of the output
+  // size (19 MB at 1280 x 948) wait for the writers, two at most.
   common::WorkQueue writers(writer_threads(), 2);
+  render::Image samples;
   for (int f = 0; f < o.frames; ++f) {
     bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
     const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
@@ -257,13 +262,12 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
     times.frame_ms.push_back(t.total_ms);
     times.gl_ms.push_back(t.gl_ms);
     times.cpu_ms.push_back(t.cpu_ms);
-    auto samples = std::make_shared<const render::Image>(renderer.read_image());
-    writers.submit([&o, f, samples, &times, &previews] {
-      const auto filter_start = Clock::now();
-      const render::Image image = render::box_downsample(*samples, o.supersample);
-      times.downsample_ms[std::size_t(f)] = 1000.0 * seconds_since(filter_start);
-      write_frame(o, f, image, previews);
-    });
+    renderer.read_image(samples);
+    const auto filter_start = Clock::now();
+    auto image = std::make_shared<const render::Image>(
+        o.supersample == 1 ? samples : render::box_downsample(samples, o.supersample));
+    times.downsample_ms[std::size_t(f)] = 1000.0 * seconds_since(filter_start);
+    writers.submit([&o, f, image, &previews] { write_frame(o, f, *image, previews); });
   }
   writers.finish();
   bar.finish();

@@ -43,6 +43,11 @@ void FrameTarget::bind(int width, int height) {
 
 Image FrameTarget::read() const {
   Image image;
+  read(image);
+  return image;
+}
+
+void FrameTarget::read(Image& image) const {
   image.width = width_;
   image.height = height_;
   image.rgba.resize(std::size_t(image.width) * image.height * 4);
@@ -57,7 +62,6 @@ Image FrameTarget::read() const {
     std::swap_ranges(image.rgba.begin() + std::ptrdiff_t(std::size_t(y) * row),
                      image.rgba.begin() + std::ptrdiff_t(std::size_t(y + 1) * row),
                      image.rgba.begin() + std::ptrdiff_t(std::size_t(image.height - 1 - y) * row));
-  return image;
 }
 
 }  // namespace render

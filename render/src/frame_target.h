@@ -20,6 +20,9 @@ class FrameTarget {
   bool empty() const { return fbo_ == 0; }
   // The colour buffer, row 0 at the top.
   Image read() const;
+  // The same into `into`, whose storage is reused when it is large enough: a fresh 2 x 2
+  // supersampled frame is 77 MB, and zeroing and faulting it in cost more than the read.
+  void read(Image& into) const;
 
  private:
   GLuint fbo_ = 0, colour_ = 0, depth_ = 0;

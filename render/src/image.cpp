@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 // Writes through OpenImageIO to a hidden temporary name with the target's extension (OIIO
 // picks the format from it), then renames; the temporary is removed on any failure.
 void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const void* data,
-                      const char* what) {
+                      const char* what, OIIO::TypeDesc data_type) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   if (!fs::is_directory(dir))
     throw ImageError(std::string("cannot write ") + what + " " + path.string() + ": directory " +
@@ -36,7 +36,7 @@ void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const v
   auto out = OIIO::ImageOutput::create(temp.string());
   if (!out) fail("no OpenImageIO writer for extension '" + path.extension().string() + "'");
   if (!out->open(temp.string(), spec)) fail(out->geterror());
-  if (!out->write_image(spec.format, data)) fail(out->geterror());
+  if (!out->write_image(data_type, data)) fail(out->geterror());
   if (!out->close()) fail(out->geterror());
   if (const std::string problem = common::output_target_problem(path); !problem.empty())
     fail(problem + "; write to another path");
@@ -64,15 +64,17 @@ float tone_map(float linear, double exposure) {
   return srgb_encode(std::clamp(f, 0.f, 1.f));
 }
 
-void write_exr(const std::filesystem::path& path, const Image& image) {
+void write_exr(const std::filesystem::path& path, const Image& image, ExrPixels pixels) {
   if (image.width < 1 || image.height < 1 ||
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
     throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
-  OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::FLOAT);
+  const bool half = pixels == ExrPixels::kHalf;
+  OIIO::ImageSpec spec(image.width, image.height, 4,
+                       half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
   spec.channelnames = {"R", "G", "B", "A"};
   spec.alpha_channel = 3;
-  spec.attribute("compression", "zip");
-  write_atomically(path, spec, image.rgba.data(), "EXR");
+  spec.attribute("compression", half ? "piz" : "zip");
+  write_atomically(path, spec, image.rgba.data(), "EXR", OIIO::TypeDesc::FLOAT);
 }
 
 void write_png(const std::filesystem::path& path, const Image& image, double exposure) {
@@ -81,7 +83,8 @@ void write_png(const std::filesystem::path& path, const Image& image, double exp
     throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
   const std::vector<std::uint8_t> rgb = tone_map_rgb8(image, exposure);
   OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-  write_atomically(path, spec, rgb.data(), "PNG");
+  spec.attribute("png:compressionLevel", 1);
+  write_atomically(path, spec, rgb.data(), "PNG", OIIO::TypeDesc::UINT8);
 }
 
 Image read_image(const std::filesystem::path& path) {

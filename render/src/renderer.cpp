@@ -218,9 +218,15 @@ FrameTiming Renderer::render(const Camera& camera,
 }
 
 Image Renderer::read_image() const {
+  Image image;
+  read_image(image);
+  return image;
+}
+
+void Renderer::read_image(Image& into) const {
   if (impl_->target.empty())
     throw GlError("Renderer::read_image: nothing rendered yet; call render() first");
-  return impl_->target.read();
+  impl_->target.read(into);
 }
 
 std::vector<Rgb> Renderer::capture_vertex_radiance(

@@ -146,6 +146,8 @@ class Renderer {
                      const Eigen::Matrix3d& rotation);
   // The framebuffer of the last frame; row 0 at the top.
   Image read_image() const;
+  // The same into `into`, reusing its storage (a frame sequence reads into one buffer).
+  void read_image(Image& into) const;
 
   // The per-vertex radiance the mode's vertex stage produces (transform feedback for the GL
   // shading paths), in the mesh's vertex order; for multipass the sum over passes.
