@@ -14,6 +14,8 @@ import signal
 import socket
 import subprocess
 import sys
+import threading
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import view_support as vs  # noqa: E402
@@ -105,6 +107,48 @@ def check_server_rules(server):
     check("favicon: 204, no body", status == 204 and body == b"", str(status))
 
 
+def hold_slow_clients(server, count):
+    """`count` connections that send a request line, then one header line every 0.5 s and
+    never finish (a slow-loris); returns a function that stops the drip and closes them."""
+    socks = [socket.create_connection((server.host, server.port), timeout=5) for _ in range(count)]
+    for s in socks:
+        s.sendall(b"GET /api/info HTTP/1.1\r\n")
+    stop = threading.Event()
+
+    def drip():
+        n = 0
+        while not stop.wait(0.5):
+            n += 1
+            for s in socks:
+                try:
+                    s.sendall(b"X-Slow-%d: 1\r\n" % n)
+                except OSError:
+                    pass
+    thread = threading.Thread(target=drip, daemon=True)
+    thread.start()
+
+    def release():
+        stop.set()
+        thread.join()
+        for s in socks:
+            s.close()
+    return release
+
+
+def check_slow_clients(server):
+    """20 slow clients must not lock others out (each connection has its own thread)."""
+    release = hold_slow_clients(server, 20)
+    time.sleep(1.0)
+    start = time.monotonic()
+    request = b"GET /api/info HTTP/1.1\r\nHost: %s:%d\r\nConnection: close\r\n\r\n" % (
+        server.host.encode(), server.port)
+    status = raw_request(server, request, timeout=5)
+    elapsed = time.monotonic() - start
+    check("/api/info beside 20 slow clients: answered in under 1 s",
+          status == 200 and elapsed < 1.0, "(%d after %.2f s)" % (status, elapsed))
+    return release
+
+
 def check_rejections(server):
     bad = [dict(w="nan"), dict(w=-5), dict(w=100000), dict(h="1e9"), dict(env_yaw="nan"),
            dict(env_yaw="inf"), dict(cam_pitch=120), dict(mode="warp"), dict(budget=-1),
@@ -189,9 +233,16 @@ def main():
         check_frames(server, tmp)
         check_rejections(server)
         check_server_rules(server)
+        release_slow = check_slow_clients(server)
     finally:
+        stop_start = time.monotonic()
         code = server.stop()
+        stop_seconds = time.monotonic() - stop_start
     check("SIGTERM exits 0", code == 0, "(exit %s; stderr %s)" % (code, server.proc.stderr.read()))
+    # The slow clients are still connected: their sockets are shut down after a grace period.
+    check("SIGTERM with 20 slow clients connected exits within 3 s", stop_seconds < 3.0,
+          "(%.2f s)" % stop_seconds)
+    release_slow()
     check("prints how many requests it served",
           any("stopped after" in line for line in server.lines), "".join(server.lines))
     again = vs.ViewServer(prtr, [mesh, "--probe", probe, "--cache", cache] + vs.SMALL_BAKE)

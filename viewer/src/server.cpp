@@ -1,5 +1,7 @@
 #include "viewer/server.h"
 
+#include "connection_threads.h"
+
 #include "page.h"
 #include "viewer/encode.h"
 #include "viewer/queue.h"
@@ -226,8 +228,10 @@ Json frame_header(const RenderedFrame& f) {
 void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions& options) {
   FrameQueue queue;
   httplib::Server server;
-  const int threads = options.threads;
-  server.new_task_queue = [threads] { return new httplib::ThreadPool(std::size_t(threads)); };
+  const auto connections = std::size_t(options.max_connections);
+  server.new_task_queue = [connections] {
+    return new detail::ConnectionThreads(connections, std::chrono::milliseconds(500));
+  };
   // Headers and body go out in separate writes: with Nagle's algorithm the body waits for
   // the client's delayed ACK (~40 ms on Linux), longer than a small frame takes to render.
   server.set_tcp_nodelay(true);

@@ -20,7 +20,9 @@ namespace viewer {
 struct ServerOptions {
   std::string host = "127.0.0.1";
   int port = 8080;  // 0: any free port (the printed URL says which)
-  int threads = 16;
+  // Connections served at once, each on its own thread (viewer/src/connection_threads.h);
+  // past this, new ones wait. Enough for a few tabs, a load test's 50 clients and 20 slow ones.
+  int max_connections = 128;
 };
 
 struct ServedInfo {
