@@ -84,6 +84,30 @@ def check_second_tab(browser, server):
     check("second tab's angle is its own", second_env.startswith("yaw 0.0°"), second_env)
 
 
+def check_refusals(browser, cx, cy):
+    """A refused setting does not poison the tab: the field goes back to the value in use,
+    the reason shows beside it, and the next drag renders."""
+    for field, bad in [("budget", "1"), ("budget", "-5000000"), ("cpp", "9999")]:
+        before = browser.evaluate("document.getElementById('%s').value" % field)
+        set_control(browser, field, bad)
+        browser.wait_for("document.getElementById('refused-%s').textContent !== '' || "
+                         "document.getElementById('%s').value !== '%s'" % (field, field, bad),
+                         what="the page's answer to %s=%s" % (field, bad))
+        time.sleep(0.5)
+        value = browser.evaluate("document.getElementById('%s').value" % field)
+        reason = text(browser, "refused-" + field)
+        # -5000000 is no budget at all: the field shows the 0 in use and nothing is refused.
+        check("%s=%s: the field shows the value in use (%s)" % (field, bad, before),
+              value == (before if bad != "-5000000" else "0"), "%r" % value)
+        if bad != "-5000000":
+            check("%s=%s: the reason is shown beside it" % (field, bad), reason != "", reason)
+        n = frames(browser)
+        browser.drag(cx - 30, cy, 60, 0)
+        settle(browser, n, "a frame after a refused %s" % field)
+        check("%s=%s: the next drag renders" % (field, bad),
+              text(browser, "stat-error") == "", text(browser, "stat-error"))
+
+
 def run(browser, server, tmp):
     browser.open(server.url + "?w=320&h=237")
     browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 1",
@@ -132,6 +156,7 @@ def run(browser, server, tmp):
     overlaid = browser.evaluate(PIXELS)
     check("overdraw overlay changes the frame", overlaid["hash"] != plain["hash"])
     check("no error shown", text(browser, "stat-error") == "", text(browser, "stat-error"))
+    check_refusals(browser, cx, cy)
     check_second_tab(browser, server)
     shot = browser.call("Page.captureScreenshot", {"format": "png"})["data"]
     path = os.path.join(tmp, "view_browser.png")

@@ -161,8 +161,13 @@ def check_rejections(server):
         one_line = body.decode(errors="replace").rstrip("\n")
         check("400 for %s" % params, status == 400 and name in one_line and "\n" not in one_line,
               "(%d %r)" % (status, body[:200]))
-    status, _, body = server.get("/frame?w=64&h=48&mode=multipass&budget=1")
-    check("400 for a budget that holds no cluster", status == 400, "(%d %r)" % (status, body))
+    for mode in ("multipass", "cpu"):  # refused whatever the mode, in the page's words
+        status, _, body = server.get("/frame?w=64&h=48&mode=%s&budget=1" % mode)
+        check("400 for a budget that holds no cluster (%s)" % mode,
+              status == 400 and body.startswith(b"budget=1: below one cluster's"),
+              "(%d %r)" % (status, body))
+    status, _, body = server.get("/frame?w=64&h=48&budget=0&cpp=4&mode=multipass")
+    check("cpp up to the clusters that fit is served", status == 200, "(%d %r)" % (status, body[:80]))
     status, _, _ = server.get("/frame?w=64&w=65")
     check("400 for a repeated parameter", status == 400)
     for path in ["/nope", "/frame/x", "/../../etc/passwd", "/%2e%2e/%2e%2e/etc/passwd",

@@ -126,6 +126,29 @@ TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
   }
 }
 
+TEST(ViewRequest, PassesMustFitInThePagesWords) {
+  // 120 registers a cluster, 4096 in the context: the page is told what would fit, by name.
+  ViewLimits l = limits();
+  l.registers_per_cluster = 120;
+  l.max_register_budget = 4096;
+  const auto refusal = [&](const QueryParams& q) {
+    try {
+      viewer::parse_view_request(q, l);
+    } catch (const RequestError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_EQ(refusal({{"budget", "100"}}),
+            "budget=100: below one cluster's 120 registers; use 0 (the context's 4096) or 120 to "
+            "4096");
+  EXPECT_EQ(refusal({{"budget", "240"}, {"cpp", "3"}}),
+            "cpp=3: 2 clusters fit the budget of 240 registers; use 0 (all that fit) or 1 to 2");
+  EXPECT_EQ(refusal({{"budget", "5000"}}).rfind("budget=", 0), 0u);
+  EXPECT_EQ(refusal({{"budget", "240"}, {"cpp", "2"}}), "(accepted)");
+  EXPECT_EQ(refusal({{"cpp", "16"}}), "(accepted)");  // 34 fit the context's budget
+}
+
 TEST(ViewRequest, RawQueriesAreSplitStrictly) {
   const QueryParams q = viewer::parse_query("w=480&mode=cpu&client=a%2Db&probe=1+");
   const QueryParams expected{{"w", "480"}, {"mode", "cpu"}, {"client", "a-b"}, {"probe", "1 "}};

@@ -180,6 +180,8 @@ Runner add_view_command(CLI::App& app) {
     const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
     viewer::ViewScene scene({&mesh, &set, transfer.path, probes, placement, background, axis, gl});
     served.limits = {int(probes.size()), set.cluster_count, true};
+    served.limits.max_register_budget = scene.info().default_register_budget;
+    served.limits.registers_per_cluster = scene.info().registers_per_cluster;
     // The initial state renders once here, so a flag the renderer refuses exits 2 now.
     const auto first = scene.render(served.defaults);
     if (!first->request_error.empty()) throw UsageError(first->request_error);

@@ -20,7 +20,7 @@ label { display: block; margin: 3px 0; }
 table { border-collapse: collapse; }
 td { padding: 1px 6px 1px 0; vertical-align: top; }
 td:first-child { color: #999; }
-#stat-error { color: #f77; }
+#stat-error, .refused { color: #f77; }
 </style></head>
 <body>
 <div id="view"><img id="frame" alt="relit mesh" draggable="false"></div>
@@ -34,8 +34,11 @@ td:first-child { color: #999; }
 <label>mode <select id="mode"></select></label>
 <label>super-clusters <select id="strategy"></select></label>
 <label>register budget <input id="budget" type="number" min="0" step="1" value="0"> (0: the context's)</label>
+<div class="refused" id="refused-budget"></div>
 <label>clusters per pass <input id="cpp" type="number" min="0" step="1" value="0"> (0: all that fit)</label>
+<div class="refused" id="refused-cpp"></div>
 <label>size <select id="size"></select></label>
+<div class="refused" id="refused-size"></div>
 </fieldset>
 <fieldset><legend>Lighting</legend>
 <label>probe <select id="probe"></select></label>
@@ -76,6 +79,10 @@ const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch:
   mode: "decoupled", strategy: "greedy-refine", budget: 0, cpp: 0, probe: 0, exposure: 0,
   overlay: "none" };
 let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
+let good = null;         // the last state that rendered: a refused setting falls back to it
+// Which control sets a query parameter, so that a refusal is shown beside it.
+const controlOf = { budget: "budget", cpp: "cpp", w: "size", h: "size", mode: "mode",
+  strategy: "strategy", probe: "probe", exposure: "exposure" };
 const log = [];          // per frame: {sent, shown, queue, render, overlay, encode, transfer}
 window.prtrLog = log;    // read by the measurement script
 
@@ -90,14 +97,40 @@ function query() {
   return q.toString();
 }
 
+// Shows a control's value as the state holds it (a typed -5 becomes the 0 in use).
+function syncControl(id) {
+  if (id === "size") $("size").value = state.w + "x" + state.h;
+  else if (id === "exposure") { $("exposure").value = state.exposure; $("exposure-value").textContent = state.exposure.toFixed(2); }
+  else if (id in state) $(id).value = String(state[id]);
+}
+
+// A 400 names the parameter first ("budget=100: ..."): that setting goes back to the last
+// one that rendered, its control says why beside it, and the view carries on.
+function refuse(status, message, sentState) {
+  const key = (message.match(/^([a-z_]+)=/) || [])[1];
+  const id = controlOf[key];
+  if (status !== 400 || !good || !id || state[key] !== sentState[key]) {
+    $("stat-error").textContent = status + ": " + message;
+    return;
+  }
+  for (const k of Object.keys(controlOf)) if (controlOf[k] === id) state[k] = good[k];
+  syncControl(id);
+  const place = $("refused-" + id) || $("stat-error");
+  place.textContent = message.replace(/^[a-z_]+=/, "").replace(/\n$/, "") +
+      " (back to " + (id === "size" ? state.w + " x " + state.h : state[key]) + ")";
+  dirty = true;
+}
+
 async function pump() {
   if (inflight || !dirty) return;
   dirty = false; inflight = true;
   const sent = performance.now();
+  const sentState = Object.assign({}, state);
   try {
     const r = await fetch("/frame?" + query(), { cache: "no-store" });
-    if (!r.ok) { $("stat-error").textContent = r.status + ": " + (await r.text()); }
+    if (!r.ok) refuse(r.status, await r.text(), sentState);
     else {
+      good = sentState;
       const f = JSON.parse(r.headers.get("X-Prtr-Frame"));
       const blob = await r.blob();
       const url = URL.createObjectURL(blob);
@@ -180,11 +213,14 @@ bindSelect("strategy", "strategy", String);
 bindSelect("probe", "probe", Number);
 for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"]])
   $(id).addEventListener("change", () => {
-    state[key] = Math.max(0, Math.floor(Number($(id).value) || 0)); changed();
+    state[key] = Math.max(0, Math.floor(Number($(id).value) || 0));
+    $(id).value = String(state[key]);
+    $("refused-" + id).textContent = "";
+    changed();
   });
 $("size").addEventListener("change", () => {
   const [w, h] = $("size").value.split("x").map(Number);
-  state.w = w; state.h = h; changed();
+  state.w = w; state.h = h; $("refused-size").textContent = ""; changed();
 });
 $("exposure").addEventListener("input", () => {
   state.exposure = Number($("exposure").value);

@@ -197,6 +197,29 @@ std::vector<std::string> view_parameter_names() {
   return names;
 }
 
+namespace {
+
+// The budget and clusters per pass, in the page's words: what must hold for a pass to
+// fit, and which values would (the renderer's own check names command-line flags).
+void check_passes(const ViewState& state, const ViewLimits& limits) {
+  const int per_cluster = std::max(1, limits.registers_per_cluster);
+  const int budget = state.register_budget > 0 ? state.register_budget : limits.max_register_budget;
+  if (state.register_budget > 0 && state.register_budget < per_cluster)
+    throw RequestError(
+        "budget=" + std::to_string(state.register_budget) + ": below one cluster's " +
+        std::to_string(per_cluster) + " registers; use 0 (the context's " +
+        std::to_string(limits.max_register_budget) + ") or " + std::to_string(per_cluster) +
+        " to " + std::to_string(limits.max_register_budget));
+  const int fit = budget / per_cluster;
+  if (state.clusters_per_pass > fit)
+    throw RequestError("cpp=" + std::to_string(state.clusters_per_pass) + ": " +
+                       std::to_string(fit) + " clusters fit the budget of " +
+                       std::to_string(budget) + " registers; use 0 (all that fit) or 1 to " +
+                       std::to_string(fit));
+}
+
+}  // namespace
+
 ViewState parse_view_request(const QueryParams& params, const ViewLimits& limits,
                              const ViewState& defaults) {
   ViewState state = defaults;
@@ -213,6 +236,7 @@ ViewState parse_view_request(const QueryParams& params, const ViewLimits& limits
     throw RequestError("w x h = " + std::to_string(state.width) + " x " +
                        std::to_string(state.height) + ": more than " +
                        std::to_string(limits.max_pixels) + " pixels");
+  check_passes(state, limits);
   return state;
 }
 

@@ -42,7 +42,8 @@ struct ViewLimits {
   bool uncompressed = false;  // the transfer set is at hand
   int max_side = 4096;
   long long max_pixels = 4096LL * 2048;
-  int max_register_budget = 1 << 20;
+  int max_register_budget = 1 << 20;  // what the GL context offers
+  int registers_per_cluster = 1;      // one cluster's constants; a budget below fits none
 };
 
 class RequestError : public std::invalid_argument {
