@@ -108,6 +108,57 @@ def check_refusals(browser, cx, cy):
               text(browser, "stat-error") == "", text(browser, "stat-error"))
 
 
+def key(browser, name, shift=False):
+    browser.evaluate("window.dispatchEvent(new KeyboardEvent('keydown', {key: '%s', shiftKey: %s}))"
+                     % (name, "true" if shift else "false"))
+
+
+def check_keys_and_autorotate(browser):
+    """Arrow keys turn the environment (shift: the camera); auto-rotation keeps frames coming
+    without input, and space stops it."""
+    env0, cam0 = text(browser, "stat-env"), text(browser, "stat-cam")
+    n = frames(browser)
+    key(browser, "ArrowRight")
+    settle(browser, n, "a frame after ArrowRight")
+    env1 = text(browser, "stat-env")
+    check("ArrowRight turns the environment", env1 != env0 and text(browser, "stat-cam") == cam0,
+          "%r -> %r" % (env0, env1))
+    n = frames(browser)
+    key(browser, "ArrowRight", shift=True)
+    settle(browser, n, "a frame after shift-ArrowRight")
+    check("shift-ArrowRight orbits the camera", text(browser, "stat-cam") != cam0 and
+          text(browser, "stat-env") == env1, text(browser, "stat-cam"))
+    n = frames(browser)
+    key(browser, " ")
+    time.sleep(2.0)
+    turning = frames(browser) - n
+    check("auto-rotate keeps frames coming without input", turning >= 3, str(turning))
+    check("auto-rotate turns the environment", text(browser, "stat-env") != env1)
+    key(browser, " ")
+    time.sleep(0.5)
+    n = frames(browser)
+    time.sleep(1.0)
+    check("space stops auto-rotation", frames(browser) - n <= 1, str(frames(browser) - n))
+
+
+def check_fit_window(browser):
+    """"fit the window": the frame fills what the panel leaves, at the device pixel ratio."""
+    n = frames(browser)
+    set_control(browser, "size", "window")
+    settle(browser, n, "a frame that fits the window")
+    box = browser.evaluate("(() => { const i = document.getElementById('frame');"
+                           " const r = i.getBoundingClientRect(); const d = devicePixelRatio;"
+                           " return [i.naturalWidth, i.naturalHeight, Math.round(r.width * d),"
+                           " Math.round(r.height * d), innerWidth, innerHeight]; })()")
+    check("fit the window: the frame is rendered at its displayed size",
+          box[0] == box[2] and box[1] == box[3] and box[0] > 320, str(box))
+    panel = browser.evaluate("document.getElementById('panel').getBoundingClientRect().bottom")
+    check("the panel fits the window's height", panel <= box[5] + 1, "%s of %s" % (panel, box[5]))
+    n = frames(browser)
+    set_control(browser, "size", "320x237")
+    settle(browser, n, "a 320 x 237 frame again")
+
+
 def run(browser, server, tmp):
     browser.open(server.url + "?w=320&h=237")
     browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 1",
@@ -157,6 +208,8 @@ def run(browser, server, tmp):
     check("overdraw overlay changes the frame", overlaid["hash"] != plain["hash"])
     check("no error shown", text(browser, "stat-error") == "", text(browser, "stat-error"))
     check_refusals(browser, cx, cy)
+    check_keys_and_autorotate(browser)
+    check_fit_window(browser)
     check_second_tab(browser, server)
     shot = browser.call("Page.captureScreenshot", {"format": "png"})["data"]
     path = os.path.join(tmp, "view_browser.png")

@@ -14,7 +14,8 @@ const char* view_page_html() {
 body { font: 13px sans-serif; margin: 0; display: flex; background: #222; color: #ddd; }
 #view { flex: none; padding: 8px; }
 #frame { display: block; background: #000; cursor: grab; user-select: none; }
-#panel { padding: 8px 12px; min-width: 300px; }
+#panel { padding: 8px 12px; min-width: 300px; max-height: 100vh; overflow-y: auto;
+  box-sizing: border-box; }
 fieldset { border: 1px solid #555; margin: 0 0 8px 0; }
 label { display: block; margin: 3px 0; }
 table { border-collapse: collapse; }
@@ -29,6 +30,9 @@ td:first-child { color: #999; }
 <label><input type="radio" name="drag" value="env" id="drag-env" checked> drag rotates the environment</label>
 <label><input type="radio" name="drag" value="cam" id="drag-cam"> drag orbits the camera</label>
 <div>shift-drag does the other; the wheel zooms. <button id="reset">reset view</button></div>
+<label><input type="checkbox" id="autorotate"> auto-rotate the environment</label>
+<div>keys: arrows turn the environment (shift: orbit the camera), + and - zoom, space
+auto-rotates, r resets</div>
 </fieldset>
 <fieldset><legend>Rendering</legend>
 <label>mode <select id="mode"></select></label>
@@ -99,7 +103,7 @@ function query() {
 
 // Shows a control's value as the state holds it (a typed -5 becomes the 0 in use).
 function syncControl(id) {
-  if (id === "size") $("size").value = state.w + "x" + state.h;
+  if (id === "size") $("size").value = fitWindow ? "window" : state.w + "x" + state.h;
   else if (id === "exposure") { $("exposure").value = state.exposure; $("exposure-value").textContent = state.exposure.toFixed(2); }
   else if (id in state) $(id).value = String(state[id]);
 }
@@ -195,6 +199,43 @@ window.addEventListener("mousemove", (e) => {
   changed();
 });
 window.addEventListener("mouseup", () => { drag = null; });
+
+// Auto-rotation turns the environment 30 degrees a second of wall time, one step per
+// animation frame; the page still sends a request only when the last image is shown.
+let lastTick = performance.now();
+function tick(now) {
+  const dt = Math.min(0.1, Math.max(0, now - lastTick) / 1000);
+  lastTick = now;
+  if ($("autorotate").checked && !drag) {
+    state.env_yaw = wrap(state.env_yaw + 30 * dt);
+    changed();
+  }
+  requestAnimationFrame(tick);
+}
+requestAnimationFrame(tick);
+
+window.addEventListener("keydown", (e) => {
+  const tag = e.target && e.target.tagName;
+  if (tag === "INPUT" || tag === "SELECT" || tag === "BUTTON") return;
+  const step = e.key === "ArrowLeft" || e.key === "ArrowUp" ? -5 : 5;
+  switch (e.key) {
+    case "ArrowLeft": case "ArrowRight":
+      if (e.shiftKey) state.cam_yaw = wrap(state.cam_yaw - step);
+      else state.env_yaw = wrap(state.env_yaw + step);
+      break;
+    case "ArrowUp": case "ArrowDown":
+      if (e.shiftKey) state.cam_pitch = clamp(state.cam_pitch + step, -89, 89);
+      else state.env_pitch = wrap(state.env_pitch + step);
+      break;
+    case "+": case "=": state.zoom = clamp(Math.round(state.zoom * 1100) / 1000, 0.1, 20); break;
+    case "-": case "_": state.zoom = clamp(Math.round(state.zoom / 1.1 * 1000) / 1000, 0.1, 20); break;
+    case " ": $("autorotate").checked = !$("autorotate").checked; break;
+    case "r": $("reset").click(); break;
+    default: return;
+  }
+  e.preventDefault();
+  changed();
+});
 $("frame").addEventListener("wheel", (e) => {
   e.preventDefault();
   state.zoom = clamp(Math.round(state.zoom * Math.exp(-e.deltaY * 0.001) * 1000) / 1000, 0.1, 20);
@@ -218,10 +259,29 @@ for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"]])
     $("refused-" + id).textContent = "";
     changed();
   });
-$("size").addEventListener("change", () => {
-  const [w, h] = $("size").value.split("x").map(Number);
-  state.w = w; state.h = h; $("refused-size").textContent = ""; changed();
-});
+// "fit the window": the frame fills what the panel leaves, at the device pixel ratio, within
+// the server's 4096-pixel sides and 8 M pixels; it follows every resize.
+let fitWindow = false;
+function fitSize() {
+  const dpr = window.devicePixelRatio || 1;
+  const cssW = Math.max(16, window.innerWidth - $("panel").offsetWidth - 16);
+  const cssH = Math.max(16, window.innerHeight - 16);
+  let w = Math.round(cssW * dpr), h = Math.round(cssH * dpr);
+  const s = Math.min(1, 4096 / w, 4096 / h, Math.sqrt(4096 * 2048 / (w * h)));
+  w = Math.max(16, Math.floor(w * s)); h = Math.max(16, Math.floor(h * s));
+  $("frame").style.width = cssW + "px"; $("frame").style.height = cssH + "px";
+  if (w !== state.w || h !== state.h) { state.w = w; state.h = h; changed(); }
+}
+window.addEventListener("resize", () => { if (fitWindow) fitSize(); });
+function chooseSize(value) {
+  fitWindow = value === "window";
+  $("refused-size").textContent = "";
+  if (fitWindow) { fitSize(); return; }
+  $("frame").style.width = ""; $("frame").style.height = "";
+  const [w, h] = value.split("x").map(Number);
+  state.w = w; state.h = h; changed();
+}
+$("size").addEventListener("change", () => chooseSize($("size").value));
 $("exposure").addEventListener("input", () => {
   state.exposure = Number($("exposure").value);
   $("exposure-value").textContent = state.exposure.toFixed(2);
@@ -258,7 +318,7 @@ async function start() {
   fill("mode", info.modes, state.mode);
   fill("strategy", info.strategies, state.strategy);
   fill("probe", info.probes.map((p, i) => [String(i), p]), state.probe);
-  const s = sizes.map(([w, h]) => [w + "x" + h, w + " × " + h]);
+  const s = [["window", "fit the window"]].concat(sizes.map(([w, h]) => [w + "x" + h, w + " × " + h]));
   if (!sizes.some(([w, h]) => w === state.w && h === state.h))
     s.unshift([state.w + "x" + state.h, state.w + " × " + state.h]);
   fill("size", s, state.w + "x" + state.h);
@@ -271,6 +331,7 @@ async function start() {
   $("stat-mesh").textContent = info.mesh + " (" + info.vertices + " vertices)";
   $("stat-gl").textContent = info.gl_renderer;
   $("stat-threads").textContent = info.llvmpipe_threads + " (" + info.llvmpipe_threads_source + ")";
+  if (urlParams.get("size") === "window") { $("size").value = "window"; chooseSize("window"); }
   changed();
 }
 start().catch((e) => { $("stat-error").textContent = String(e); });
