@@ -169,6 +169,9 @@ def run(browser, server, tmp):
     check("statistics: renderer shown", "llvmpipe" in text(browser, "stat-gl"))
     check("statistics: clusters, PCs, order",
           [text(browser, e) for e in ("stat-clusters", "stat-pcs", "stat-order")] == ["4", "2", "3"])
+    browser.wait_for("document.getElementById('stat-aa').textContent === '2 × 2'",
+                     what="the still view anti-aliased")
+    check("the still view is refined to 2 x 2 samples", text(browser, "stat-aa") == "2 × 2")
     env0 = text(browser, "stat-env")
 
     rect = browser.evaluate("(() => { const r = document.getElementById('frame')"

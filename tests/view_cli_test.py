@@ -66,6 +66,10 @@ def check_frames(server, tmp):
     for mode in ("singlepass", "cpu", "uncompressed"):
         _, minfo = frame(server, mode, seq=6, mode=mode, **base)
         check(mode + ": reported", minfo.get("mode") == mode, str(minfo))
+    aliased, _ = frame(server, "one sample per pixel", seq=7, aa=1, **base)
+    smooth, ainfo = frame(server, "2 x 2 samples per pixel", seq=8, aa=2, **base)
+    check("aa=2: reported, and the frame differs", ainfo.get("aa") == 2 and smooth != aliased,
+          str(ainfo))
 
 
 def raw_request(server, request, timeout=10):

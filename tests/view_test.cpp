@@ -47,11 +47,23 @@ TEST(ViewRequest, NoParametersGiveTheDefaults) {
 }
 
 TEST(ViewRequest, EveryParameterLandsInTheState) {
-  const QueryParams q = {
-      {"client", "tab-1_x"}, {"seq", "42"},         {"w", "640"},          {"h", "474"},
-      {"env_yaw", "-30.5"},  {"env_pitch", "12"},   {"cam_yaw", "90"},     {"cam_pitch", "-45"},
-      {"zoom", "1.5"},       {"mode", "multipass"}, {"strategy", "order"}, {"budget", "512"},
-      {"cpp", "4"},          {"probe", "1"},        {"exposure", "-1.25"}, {"overlay", "overdraw"}};
+  const QueryParams q = {{"client", "tab-1_x"},
+                         {"seq", "42"},
+                         {"w", "640"},
+                         {"h", "474"},
+                         {"env_yaw", "-30.5"},
+                         {"env_pitch", "12"},
+                         {"cam_yaw", "90"},
+                         {"cam_pitch", "-45"},
+                         {"zoom", "1.5"},
+                         {"mode", "multipass"},
+                         {"strategy", "order"},
+                         {"budget", "512"},
+                         {"cpp", "4"},
+                         {"probe", "1"},
+                         {"exposure", "-1.25"},
+                         {"overlay", "overdraw"},
+                         {"aa", "2"}};
   const ViewState s = viewer::parse_view_request(q, limits());
   EXPECT_EQ(s.client, "tab-1_x");
   EXPECT_EQ(s.seq, 42u);
@@ -69,6 +81,7 @@ TEST(ViewRequest, EveryParameterLandsInTheState) {
   EXPECT_EQ(s.probe, 1);
   EXPECT_EQ(s.exposure, -1.25);
   EXPECT_EQ(s.overlay, viewer::Overlay::kOverdraw);
+  EXPECT_EQ(s.samples, 2);
   EXPECT_EQ(q.size(), viewer::view_parameter_names().size());  // all of them were covered
 }
 
@@ -112,6 +125,9 @@ TEST(ViewRequest, BadParametersAreRefusedNamingThem) {
       {{{"client", std::string(33, 'a')}}, "client"},
       {{{"client", ""}}, "client"},
       {{{"seq", "-1"}}, "seq"},
+      {{{"aa", "0"}}, "aa"},
+      {{{"aa", "5"}}, "aa"},
+      {{{"aa", "4"}, {"w", "4096"}, {"h", "2048"}}, "aa=4"},
   };
   for (const Case& c : cases) {
     try {

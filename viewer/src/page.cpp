@@ -42,6 +42,7 @@ auto-rotates, r resets</div>
 <label>clusters per pass <input id="cpp" type="number" min="0" step="1" value="0"> (0: all that fit)</label>
 <div class="refused" id="refused-cpp"></div>
 <label>size <select id="size"></select></label>
+<label><input type="checkbox" id="antialias" checked> anti-alias the still image (2 × 2 samples once the view stops)</label>
 <div class="refused" id="refused-size"></div>
 </fieldset>
 <fieldset><legend>Lighting</legend>
@@ -59,6 +60,7 @@ auto-rotates, r resets</div>
 <tr><td>environment</td><td id="stat-env">-</td></tr>
 <tr><td>camera</td><td id="stat-cam">-</td></tr>
 <tr><td>mode</td><td id="stat-mode">-</td></tr>
+<tr><td>samples per pixel</td><td id="stat-aa">-</td></tr>
 <tr><td>passes</td><td id="stat-passes">-</td></tr>
 <tr><td>average overdraw</td><td id="stat-overdraw">-</td></tr>
 <tr><td>clusters per pass</td><td id="stat-cpp">-</td></tr>
@@ -81,7 +83,7 @@ const client = "c" + Math.random().toString(36).slice(2, 12);
 const urlParams = new URLSearchParams(location.search);
 const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch: 0, zoom: 1,
   mode: "decoupled", strategy: "greedy-refine", budget: 0, cpp: 0, probe: 0, exposure: 0,
-  overlay: "none" };
+  overlay: "none", aa: 1 };
 let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
 let good = null;         // the last state that rendered: a refused setting falls back to it
 // Which control sets a query parameter, so that a refusal is shown beside it.
@@ -93,7 +95,9 @@ window.prtrLog = log;    // read by the measurement script
 const sizes = [[320, 237], [480, 355], [640, 474], [960, 710], [1280, 948]];
 function wrap(a) { a = ((a + 180) % 360 + 360) % 360 - 180; return Math.round(a * 100) / 100; }
 function clamp(x, lo, hi) { return Math.min(hi, Math.max(lo, x)); }
-function changed() { dirty = true; pump(); }
+// Any change renders one sample per pixel at once; when the view has stopped, the same view
+// is rendered again anti-aliased (4x the render, once).
+function changed() { state.aa = 1; dirty = true; pump(); }
 
 function query() {
   const q = new URLSearchParams({ client: client, seq: String(++seq) });
@@ -155,6 +159,17 @@ async function pump() {
   } catch (e) { $("stat-error").textContent = String(e); }
   inflight = false;
   if (dirty) pump();
+  else refineStill();
+}
+
+// The view has stopped (nothing in flight or waiting, no drag, no auto-rotation): render the
+// last frame's view again with 2 x 2 samples per pixel, once.
+function refineStill() {
+  if (inflight || dirty || !good || good.aa !== 1 || state.aa !== 1 || drag ||
+      !$("antialias").checked || $("autorotate").checked) return;
+  state.aa = 2;
+  dirty = true;
+  pump();
 }
 
 function showStats(f, total, server) {
@@ -174,6 +189,7 @@ function showStats(f, total, server) {
       "°, zoom " + f.zoom.toFixed(2);
   $("stat-mode").textContent = f.mode + (f.mode === "multipass" || f.mode === "decoupled" ? " / " + f.strategy : "");
   $("stat-passes").textContent = String(f.passes);
+  $("stat-aa").textContent = f.aa + " × " + f.aa;
   $("stat-overdraw").textContent = f.average_overdraw.toFixed(3);
   $("stat-cpp").textContent = String(f.clusters_per_pass);
   $("stat-budget").textContent = String(f.register_budget);
@@ -198,7 +214,8 @@ window.addEventListener("mousemove", (e) => {
   }
   changed();
 });
-window.addEventListener("mouseup", () => { drag = null; });
+window.addEventListener("mouseup", () => { drag = null; refineStill(); });
+$("antialias").addEventListener("change", () => { if (!$("antialias").checked) changed(); else refineStill(); });
 
 // Auto-rotation turns the environment 30 degrees a second of wall time, one step per
 // animation frame; the page still sends a request only when the last image is shown.
@@ -229,7 +246,7 @@ window.addEventListener("keydown", (e) => {
       break;
     case "+": case "=": state.zoom = clamp(Math.round(state.zoom * 1100) / 1000, 0.1, 20); break;
     case "-": case "_": state.zoom = clamp(Math.round(state.zoom / 1.1 * 1000) / 1000, 0.1, 20); break;
-    case " ": $("autorotate").checked = !$("autorotate").checked; break;
+    case " ": $("autorotate").checked = !$("autorotate").checked; break;  // changed() below
     case "r": $("reset").click(); break;
     default: return;
   }

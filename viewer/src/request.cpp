@@ -129,6 +129,7 @@ const std::vector<std::pair<std::string, Setter>>& setters() {
        [](S& s, V v, L l) { s.probe = int(parse_integer("probe", v, 0, l.probe_count - 1)); }},
       {"exposure", [](S& s, V v, L) { s.exposure = parse_double("exposure", v, -20, 20); }},
       {"overlay", set_overlay},
+      {"aa", [](S& s, V v, L) { s.samples = int(parse_integer("aa", v, 1, 4)); }},
   };
   return table;
 }
@@ -236,6 +237,14 @@ ViewState parse_view_request(const QueryParams& params, const ViewLimits& limits
     throw RequestError("w x h = " + std::to_string(state.width) + " x " +
                        std::to_string(state.height) + ": more than " +
                        std::to_string(limits.max_pixels) + " pixels");
+  const long long samples =
+      std::int64_t(state.width) * state.height * state.samples * state.samples;
+  if (samples > limits.max_pixels)
+    throw RequestError("aa=" + std::to_string(state.samples) + ": " + std::to_string(state.width) +
+                       " x " + std::to_string(state.height) + " pixels at " +
+                       std::to_string(state.samples * state.samples) +
+                       " samples each are more than " + std::to_string(limits.max_pixels) +
+                       "; use aa=1 at this size");
   check_passes(state, limits);
   return state;
 }

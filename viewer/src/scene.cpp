@@ -9,6 +9,7 @@
 #include "render/pass_grouping.h"
 #include "render/renderer.h"
 #include "render/shading.h"
+#include "render/supersample.h"
 #include "viewer/encode.h"
 
 #include <chrono>
@@ -162,9 +163,13 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   }
   frame.stats.setup_ms = ms_since(setup_start);
   const render::Camera camera = view_camera(inputs.camera, *inputs.mesh, s);
-  const render::FrameTiming t = cached.renderer->render(camera, sh, environment_rotation(axis, s));
+  // Anti-aliased frames render the same view at `samples` times the size and box-filter it
+  // (render/supersample.h, as relight's frames); the overlays are drawn at the output size.
+  const render::Camera drawn = s.samples > 1 ? render::supersampled(camera, s.samples) : camera;
+  const render::FrameTiming t = cached.renderer->render(drawn, sh, environment_rotation(axis, s));
   const auto read_start = Clock::now();
-  frame.image = cached.renderer->read_image();
+  cached.renderer->read_image(frame.image);
+  if (s.samples > 1) frame.image = render::box_downsample(frame.image, s.samples);
   frame.stats.readback_ms = ms_since(read_start);
   frame.stats.render_ms = ms_since(start);
   frame.stats.frame_ms = t.total_ms;

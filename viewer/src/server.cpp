@@ -204,6 +204,7 @@ Json frame_header(const RenderedFrame& f) {
               {"strategy", s.strategy},
               {"probe", s.probe},
               {"overlay", overlay_name(s.overlay)},
+              {"aa", s.samples},
               {"env_yaw", s.env_yaw},
               {"env_pitch", s.env_pitch},
               {"cam_yaw", s.cam_yaw},

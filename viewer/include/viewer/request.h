@@ -33,6 +33,7 @@ struct ViewState {
   int probe = 0;              // index into ViewLimits::probe_count
   double exposure = 0;        // stops
   Overlay overlay = Overlay::kNone;
+  int samples = 1;  // anti-aliasing: samples x samples per pixel, box-filtered (1: off)
 };
 
 // What the server accepts; the parser checks against it.
