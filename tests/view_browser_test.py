@@ -210,6 +210,15 @@ def run(browser, server, tmp):
     overlaid = browser.evaluate(PIXELS)
     check("overdraw overlay changes the frame", overlaid["hash"] != plain["hash"])
     check("no error shown", text(browser, "stat-error") == "", text(browser, "stat-error"))
+    n = frames(browser)
+    browser.evaluate("document.getElementById('overlay-difference').click()")
+    settle(browser, n, "a frame of the difference view")
+    shown = text(browser, "stat-difference")
+    check("difference view: the overlay switches and the RMS is shown",
+          not browser.evaluate("document.getElementById('overlay-overdraw').checked") and
+          shown.startswith("RMS "), shown)
+    check("difference view changes the frame", browser.evaluate(PIXELS)["hash"] != overlaid["hash"])
+    browser.evaluate("document.getElementById('overlay-difference').click()")
     check_refusals(browser, cx, cy)
     check_keys_and_autorotate(browser)
     check_fit_window(browser)

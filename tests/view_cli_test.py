@@ -66,6 +66,10 @@ def check_frames(server, tmp):
     for mode in ("singlepass", "cpu", "uncompressed"):
         _, minfo = frame(server, mode, seq=6, mode=mode, **base)
         check(mode + ": reported", minfo.get("mode") == mode, str(minfo))
+    _, dinfo = frame(server, "difference view", seq=9, overlay="difference", **base)
+    rms = dinfo.get("difference_rms", -1)
+    # 4 clusters x 2 PCs of an order-3 sphere: a few percent from the exact transfer, not 0.
+    check("difference view: RMS reported, above 0 and below 50 %", 0 < rms < 0.5, str(dinfo))
     aliased, _ = frame(server, "one sample per pixel", seq=7, aa=1, **base)
     smooth, ainfo = frame(server, "2 x 2 samples per pixel", seq=8, aa=2, **base)
     check("aa=2: reported, and the frame differs", ainfo.get("aa") == 2 and smooth != aliased,

@@ -12,6 +12,8 @@
 #include "meshes/procedural.h"
 #include "render/image.h"
 
+#include "difference.h"  // viewer/src: the difference view is private to the viewer
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -214,6 +216,27 @@ std::shared_ptr<viewer::RenderedFrame> frame_for(const ViewState& s) {
   auto f = std::make_shared<viewer::RenderedFrame>();
   f->state = s;
   return f;
+}
+
+TEST(ViewDifference, RelativeLuminanceAgainstTheReference) {
+  // 4 x 1: background, a pixel 5 % too bright, one exact, one dark pixel under the floor.
+  render::Image reference{4, 1, {0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 1, 0, 0, 0, 1}};
+  render::Image test = reference;
+  for (int c = 0; c < 3; ++c) test.rgba[4 + c] = 1.05f;
+  test.rgba[12] = 0.01f;  // red only: luminance 0.2126 x 0.01
+  const render::Colour8 key{255, 0, 255};
+  viewer::detail::DifferenceStats d;
+  const render::Picture p = viewer::detail::difference_picture(test, reference, 0.1, key, &d);
+  EXPECT_EQ(p.at(0, 0), key);                                     // background stays see-through
+  EXPECT_EQ(p.at(1, 0), viewer::detail::difference_colour(0.5));  // 5 % of a 10 % scale
+  EXPECT_EQ(p.at(2, 0), viewer::detail::difference_colour(0.0));
+  // Floor: 1 % of the mean reference luminance over the 3 covered pixels, (1 + 2 + 0) / 3.
+  const double dark = 0.2126 * 0.01 / 0.01;
+  EXPECT_NEAR(d.max, dark, 1e-6);
+  EXPECT_NEAR(d.rms, std::sqrt((0.05 * 0.05 + dark * dark) / 3), 1e-6);
+  EXPECT_THROW(viewer::detail::difference_picture(test, render::Image{2, 1, std::vector<float>(8)},
+                                                  0.1, key),
+               std::invalid_argument);
 }
 
 TEST(ViewQueue, NewerRequestsOfAClientReplaceTheWaitingOneAndShareItsFrame) {

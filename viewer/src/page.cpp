@@ -52,6 +52,7 @@ auto-rotates, r resets</div>
 <fieldset><legend>Overlays</legend>
 <label><input type="checkbox" id="overlay-overdraw"> overdraw (passes per triangle)</label>
 <label><input type="checkbox" id="overlay-clusters"> clusters</label>
+<label><input type="checkbox" id="overlay-difference"> difference from the uncompressed transfer (red: 10 % or more)</label>
 </fieldset>
 <fieldset><legend>Statistics</legend><table>
 <tr><td>render FPS</td><td id="stat-render-fps">-</td></tr>
@@ -69,6 +70,7 @@ auto-rotates, r resets</div>
 <tr><td>PCs</td><td id="stat-pcs">-</td></tr>
 <tr><td>order</td><td id="stat-order">-</td></tr>
 <tr><td>Average SE</td><td id="stat-se">-</td></tr>
+<tr><td>difference</td><td id="stat-difference">-</td></tr>
 <tr><td>mesh</td><td id="stat-mesh">-</td></tr>
 <tr><td>renderer</td><td id="stat-gl">-</td></tr>
 <tr><td>llvmpipe threads</td><td id="stat-threads">-</td></tr>
@@ -190,6 +192,9 @@ function showStats(f, total, server) {
   $("stat-mode").textContent = f.mode + (f.mode === "multipass" || f.mode === "decoupled" ? " / " + f.strategy : "");
   $("stat-passes").textContent = String(f.passes);
   $("stat-aa").textContent = f.aa + " × " + f.aa;
+  $("stat-difference").textContent = f.overlay === "difference"
+      ? "RMS " + (100 * f.difference_rms).toFixed(2) + " %, max " + (100 * f.difference_max).toFixed(1) + " %"
+      : "-";
   $("stat-overdraw").textContent = f.average_overdraw.toFixed(3);
   $("stat-cpp").textContent = String(f.clusters_per_pass);
   $("stat-budget").textContent = String(f.register_budget);
@@ -304,15 +309,14 @@ $("exposure").addEventListener("input", () => {
   $("exposure-value").textContent = state.exposure.toFixed(2);
   changed();
 });
-function overlayChanged(id, other, name) {
-  $(id).addEventListener("change", () => {
-    if ($(id).checked) $(other).checked = false;
-    state.overlay = $(id).checked ? name : ($(other).checked ? state.overlay : "none");
+// One overlay at a time: checking one unchecks the others.
+const overlays = ["overdraw", "clusters", "difference"];
+for (const name of overlays)
+  $("overlay-" + name).addEventListener("change", () => {
+    for (const other of overlays) if (other !== name) $("overlay-" + other).checked = false;
+    state.overlay = $("overlay-" + name).checked ? name : "none";
     changed();
   });
-}
-overlayChanged("overlay-overdraw", "overlay-clusters", "overdraw");
-overlayChanged("overlay-clusters", "overlay-overdraw", "clusters");
 
 function fill(id, values, selected) {
   const sel = $(id);

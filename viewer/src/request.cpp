@@ -16,8 +16,10 @@
 namespace viewer {
 namespace {
 
-constexpr common::EnumName<Overlay> kOverlayNames[] = {
-    {Overlay::kNone, "none"}, {Overlay::kOverdraw, "overdraw"}, {Overlay::kClusters, "clusters"}};
+constexpr common::EnumName<Overlay> kOverlayNames[] = {{Overlay::kNone, "none"},
+                                                       {Overlay::kOverdraw, "overdraw"},
+                                                       {Overlay::kClusters, "clusters"},
+                                                       {Overlay::kDifference, "difference"}};
 
 // A request value quoted in a reason: bounded and printable, so a reason stays one short line.
 std::string quoted(const std::string& value) {
@@ -92,12 +94,14 @@ void set_strategy(ViewState& s, const std::string& v, const ViewLimits&) {
   s.strategy = v;
 }
 
-void set_overlay(ViewState& s, const std::string& v, const ViewLimits&) {
+void set_overlay(ViewState& s, const std::string& v, const ViewLimits& l) {
   try {
     s.overlay = common::parse_enum<Overlay>(kOverlayNames, v, "overlay");
   } catch (const std::invalid_argument&) {
     reject("overlay", v, "use " + common::enum_name_list<Overlay>(kOverlayNames));
   }
+  if (s.overlay == Overlay::kDifference && !l.uncompressed)
+    reject("overlay", v, "the uncompressed transfer is not at hand");
 }
 
 // One entry per parameter: its name and how it lands in the state. Angles accept any finite

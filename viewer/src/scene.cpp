@@ -1,6 +1,7 @@
 #include "viewer/scene.h"
 
 #include "cpca/supercluster_strategy.h"
+#include "difference.h"
 #include "probes/load.h"
 #include "prt/projection.h"
 #include "prt/sh_rotation.h"
@@ -34,7 +35,8 @@ double radians(double degrees) {
 // Renderers are large (per-pass vertex blocks, constants) and slow to build (grouping,
 // uploads), so a few are kept for switching back and forth, not one per combination.
 constexpr std::size_t kRenderersKept = 3;
-constexpr std::size_t kProbesKept = 2;  // texels for uploads; SH lighting is kept for all
+constexpr std::size_t kProbesKept = 2;        // texels for uploads; SH lighting is kept for all
+constexpr double kDifferenceFullScale = 0.1;  // the difference view's red: 10 % or more
 
 struct CachedRenderer {
   std::string key;
@@ -61,6 +63,7 @@ struct ViewScene::Impl {
                                         const std::optional<cpca::SuperClusters>& groups) const;
   void add_overlay(RenderedFrame& frame, const CachedRenderer& cached,
                    const render::Camera& camera) const;
+  void add_difference(RenderedFrame& frame, const render::Camera& drawn, const prt::ShLighting& sh);
   void render_into(RenderedFrame& frame);
 
   SceneInputs inputs;
@@ -180,7 +183,36 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   frame.stats.average_overdraw = rs.average_overdraw;
   frame.stats.clusters_per_pass = rs.clusters_per_pass;
   frame.stats.register_budget = rs.register_budget;
-  add_overlay(frame, cached, camera);
+  if (s.overlay == Overlay::kDifference)
+    add_difference(frame, drawn, sh);
+  else
+    add_overlay(frame, cached, camera);
+}
+
+// The same view through the uncompressed transfer (its own cached renderer), then the
+// difference picture of the two.
+void ViewScene::Impl::add_difference(RenderedFrame& frame, const render::Camera& drawn,
+                                     const prt::ShLighting& sh) {
+  const auto start = Clock::now();
+  const ViewState& s = frame.state;
+  ViewState reference_state = s;
+  reference_state.mode = render::Mode::kUncompressed;
+  CachedRenderer& reference = renderer_for(reference_state);
+  if (reference.probe != s.probe) {
+    reference.renderer->set_probe(&probe_texels(s.probe));
+    reference.probe = s.probe;
+  }
+  reference.renderer->render(drawn, sh, environment_rotation(axis, s));
+  render::Image exact;
+  reference.renderer->read_image(exact);
+  if (s.samples > 1) exact = render::box_downsample(exact, s.samples);
+  detail::DifferenceStats d;
+  frame.overlay =
+      detail::difference_picture(frame.image, exact, kDifferenceFullScale, kOverlayTransparent, &d);
+  frame.overlay_opacity = 1.0;
+  frame.stats.difference_rms = d.rms;
+  frame.stats.difference_max = d.max;
+  frame.stats.overlay_ms = ms_since(start);
 }
 
 ViewScene::ViewScene(SceneInputs inputs) : impl_(std::make_unique<Impl>(std::move(inputs))) {

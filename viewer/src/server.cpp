@@ -81,7 +81,8 @@ void send_frame(const FramePtr& frame, httplib::Response& res) {
     const auto start = Clock::now();
     std::vector<std::uint8_t> rgb = render::tone_map_rgb8(frame->image, frame->state.exposure);
     if (frame->overlay)
-      composite_overlay(rgb, frame->image.width, frame->image.height, *frame->overlay, 0.65);
+      composite_overlay(rgb, frame->image.width, frame->image.height, *frame->overlay,
+                        frame->overlay_opacity);
     frame->jpeg = encode_jpeg(rgb, frame->image.width, frame->image.height);
     frame->encode_ms = ms_since(start);
   });
@@ -222,6 +223,8 @@ Json frame_header(const RenderedFrame& f) {
               {"cpu_ms", t.cpu_ms},
               {"gl_ms", t.gl_ms},
               {"overlay_ms", t.overlay_ms},
+              {"difference_rms", t.difference_rms},
+              {"difference_max", t.difference_max},
               {"encode_ms", f.encode_ms},
               {"requests", t.requests}};
 }

@@ -27,12 +27,15 @@ struct FrameStats {
   int passes = 1, clusters_per_pass = 0, register_budget = 0;
   double average_overdraw = 1;
   int requests = 1;  // requests this frame answers (1 + coalesced)
+  // The difference overlay's relative luminance difference from the uncompressed frame.
+  double difference_rms = 0, difference_max = 0;
 };
 
 struct RenderedFrame {
   ViewState state;  // as rendered (the newest of the coalesced requests)
   render::Image image;
   std::optional<render::Picture> overlay;
+  double overlay_opacity = 0.65;  // the difference view is shown opaque
   FrameStats stats;
   std::string request_error;  // the state cannot be rendered (HTTP 400); image empty
   std::string server_error;   // rendering failed (HTTP 500); image empty

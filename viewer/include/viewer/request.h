@@ -16,7 +16,7 @@
 
 namespace viewer {
 
-enum class Overlay { kNone, kOverdraw, kClusters };
+enum class Overlay { kNone, kOverdraw, kClusters, kDifference };
 const char* overlay_name(Overlay overlay);
 
 struct ViewState {
