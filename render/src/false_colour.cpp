@@ -17,7 +17,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <random>
 #include <stdexcept>
 
 namespace render {
@@ -262,35 +261,7 @@ bool draw_text(Picture& picture, int x, int y, const std::string& text, int size
 }
 
 void write_picture_png(const fs::path& path, const Picture& picture) {
-  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir))
-    throw ImageError("cannot write picture " + path.string() + ": directory " + dir.string() +
-                     " does not exist; create it first");
-  std::random_device rd;
-  // Built by appending: GCC 12 flags "." + std::string as an overlapping memcpy
-  // (-Wrestrict false positive).
-  std::string name = path.stem().string();
-  name.insert(name.begin(), '.');
-  name += ".tmp";
-  name += std::to_string(rd() % 1000000);
-  name += ".png";
-  const fs::path temp = dir / name;
-  auto fail = [&](const std::string& why) {
-    std::error_code ec;
-    fs::remove(temp, ec);
-    throw ImageError("cannot write picture " + path.string() + ": " + why);
-  };
-  auto out = OIIO::ImageOutput::create(temp.string());
-  if (!out) fail("no PNG writer in OpenImageIO");
-  const OIIO::ImageSpec spec(picture.width, picture.height, 3, OIIO::TypeDesc::UINT8);
-  if (!out->open(temp.string(), spec)) fail(out->geterror());
-  if (!out->write_image(OIIO::TypeDesc::UINT8, picture.rgb.data())) fail(out->geterror());
-  if (!out->close()) fail(out->geterror());
-  if (const std::string problem = common::output_target_problem(path); !problem.empty())
-    fail(problem + "; write to another path");
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) fail("rename failed: " + ec.message());
+  write_rgb8_png(path, picture.width, picture.height, picture.rgb, "picture");
 }
 
 }  // namespace render

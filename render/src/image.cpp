@@ -81,10 +81,17 @@ void write_png(const std::filesystem::path& path, const Image& image, double exp
   if (image.width < 1 || image.height < 1 ||
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
     throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
-  const std::vector<std::uint8_t> rgb = tone_map_rgb8(image, exposure);
-  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  write_rgb8_png(path, image.width, image.height, tone_map_rgb8(image, exposure));
+}
+
+void write_rgb8_png(const std::filesystem::path& path, int width, int height,
+                    const std::vector<std::uint8_t>& rgb, const char* what) {
+  if (width < 1 || height < 1 || rgb.size() != std::size_t(width) * std::size_t(height) * 3)
+    throw ImageError(std::string("cannot write ") + what + " " + path.string() +
+                     ": the image is empty or mis-sized");
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("png:compressionLevel", 1);
-  write_atomically(path, spec, rgb.data(), "PNG", OIIO::TypeDesc::UINT8);
+  write_atomically(path, spec, rgb.data(), what, OIIO::TypeDesc::UINT8);
 }
 
 Image read_image(const std::filesystem::path& path) {

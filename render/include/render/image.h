@@ -47,6 +47,11 @@ void write_exr(const std::filesystem::path& path, const Image& image,
 // frame writes in 63 ms instead of 280 ms at zlib's default, for a few percent more bytes.
 void write_png(const std::filesystem::path& path, const Image& image, double exposure = 0.0);
 
+// 8-bit RGB bytes (row 0 at the top) as a PNG, byte for byte, written atomically like every
+// image here; `what` names the file in messages ("PNG", "picture").
+void write_rgb8_png(const std::filesystem::path& path, int width, int height,
+                    const std::vector<std::uint8_t>& rgb, const char* what = "PNG");
+
 // The tone map above for one linear value, before quantisation (for tests and previews).
 float tone_map(float linear, double exposure);
 
