@@ -45,7 +45,7 @@ bool contains(const std::string& s, const std::string& part) {
 
 // The loader must fail with a message naming the file and containing `phrase`, within a
 // second (the inputs here once took minutes).
-void expect_mesh_error(const fs::path& p, const std::string& phrase) {
+void expect_mesh_error(const fs::path& p, const std::string& phrase, double max_seconds = 1.0) {
   SCOPED_TRACE(p.filename().string());
   const auto start = std::chrono::steady_clock::now();
   const std::string msg = error_of([&] { meshes::load_mesh(p); });
@@ -53,7 +53,7 @@ void expect_mesh_error(const fs::path& p, const std::string& phrase) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_TRUE(contains(msg, p.filename().string())) << msg;
   EXPECT_TRUE(contains(msg, phrase)) << msg;
-  EXPECT_LT(seconds, 1.0) << msg;
+  EXPECT_LT(seconds, max_seconds) << msg;
 }
 
 void expect_probe_error(const fs::path& p, const std::string& phrase) {
@@ -404,7 +404,8 @@ TEST(HostileGltf, InstancingIsBoundedFromTheCounts) {
   std::ofstream(dir / "primitives.gltf") << gltf(
       R"("scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],"meshes":[{"primitives":[)" + primitives +
       R"(]}],"buffers":[{"byteLength":120024,"uri":"grid.bin"}],"bufferViews":[{"buffer":0,"byteLength":120024}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}])");
-  expect_mesh_error(dir / "primitives.gltf", "70000 mesh primitives");
+  // 2 MB of JSON: parsing it takes 2 s under the sanitizers, so the bound is looser here.
+  expect_mesh_error(dir / "primitives.gltf", "70000 mesh primitives", 10.0);
 }
 
 // --- Extreme but finite coordinates -----------------------------------------------------------

@@ -12,6 +12,7 @@
 #include "pipeline/pipeline.h"
 #include "probes/load.h"
 #include "progress_bar.h"
+#include "supersample_flag.h"
 #include "view_flags.h"
 #include "viewer/scene.h"
 #include "viewer/server.h"
@@ -41,6 +42,7 @@ struct Options {
   viewer::ServerOptions server;
   GlFlags gl;
   int register_budget = 0;
+  int supersample = kDefaultSupersample;
   bool quiet = false;
 };
 
@@ -63,6 +65,8 @@ void add_flags(CLI::App* cmd, Options& o) {
   o.view.width = 960;  // the page's default size; it can ask for others
   o.view.height = 710;
   add_view_flags(cmd, o.view);
+  add_supersample_flag(cmd, o.supersample,
+                       "the page's still views (moving ones have one sample per pixel)", 4);
   add_gl_flags(cmd, o.gl);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--host", o.server.host, "Address to listen on")->capture_default_str();
@@ -117,6 +121,7 @@ Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::Compresse
               {"llvmpipe_threads_source", scene.llvmpipe_threads_source},
               {"default_register_budget", scene.default_register_budget},
               {"registers_per_cluster", scene.registers_per_cluster},
+              {"still_samples", o.supersample},
               {"modes", render::mode_names()},
               {"strategies", strategies},
               {"probes", names},

@@ -4,11 +4,11 @@
 
 namespace prtr_app {
 
-void add_supersample_flag(CLI::App* cmd, int& factor) {
-  cmd->add_option("--supersample", factor,
-                  "Anti-aliasing of the written frames: render N x N samples per pixel and "
-                  "box-filter (1: off)")
-      ->check(integer_in(1, 8))
+void add_supersample_flag(CLI::App* cmd, int& factor, const std::string& what, int max) {
+  cmd->add_option(
+         "--supersample", factor,
+         "Anti-aliasing of " + what + ": render N x N samples per pixel and box-filter (1: off)")
+      ->check(integer_in(1, max))
       ->capture_default_str();
 }
 

@@ -4,10 +4,14 @@
 
 #include <CLI/CLI.hpp>
 
+#include <string>
+
 namespace prtr_app {
 
 inline constexpr int kDefaultSupersample = 2;
 
-void add_supersample_flag(CLI::App* cmd, int& factor);
+// `what` says what is anti-aliased; `max` bounds N.
+void add_supersample_flag(CLI::App* cmd, int& factor,
+                          const std::string& what = "the written frames", int max = 8);
 
 }  // namespace prtr_app

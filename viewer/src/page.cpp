@@ -42,7 +42,7 @@ auto-rotates, r resets</div>
 <label>clusters per pass <input id="cpp" type="number" min="0" step="1" value="0"> (0: all that fit)</label>
 <div class="refused" id="refused-cpp"></div>
 <label>size <select id="size"></select></label>
-<label><input type="checkbox" id="antialias" checked> anti-alias the still image (2 × 2 samples once the view stops)</label>
+<label><input type="checkbox" id="antialias" checked> anti-alias the still image (<span id="antialias-samples">2 × 2</span> samples once the view stops)</label>
 <div class="refused" id="refused-size"></div>
 </fieldset>
 <fieldset><legend>Lighting</legend>
@@ -88,6 +88,7 @@ const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch:
   overlay: "none", aa: 1 };
 let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
 let good = null;         // the last state that rendered: a refused setting falls back to it
+let stillSamples = 2;    // prtr view --supersample: samples per pixel of a still view
 // Which control sets a query parameter, so that a refusal is shown beside it.
 const controlOf = { budget: "budget", cpp: "cpp", w: "size", h: "size", mode: "mode",
   strategy: "strategy", probe: "probe", exposure: "exposure" };
@@ -169,7 +170,7 @@ async function pump() {
 function refineStill() {
   if (inflight || dirty || !good || good.aa !== 1 || state.aa !== 1 || drag ||
       !$("antialias").checked || $("autorotate").checked) return;
-  state.aa = 2;
+  state.aa = stillSamples;
   dirty = true;
   pump();
 }
@@ -333,6 +334,9 @@ async function start() {
   state.mode = info.defaults.mode; state.strategy = info.defaults.strategy;
   state.probe = info.defaults.probe; state.exposure = info.defaults.exposure;
   state.w = info.defaults.width; state.h = info.defaults.height;
+  stillSamples = info.still_samples;
+  if (stillSamples < 2) { $("antialias").checked = false; $("antialias").disabled = true; }
+  $("antialias-samples").textContent = stillSamples + " × " + stillSamples;
   if (urlParams.has("w")) state.w = Number(urlParams.get("w"));
   if (urlParams.has("h")) state.h = Number(urlParams.get("h"));
   if (urlParams.has("mode")) state.mode = urlParams.get("mode");
