@@ -152,8 +152,11 @@ def check_slow_clients(server):
         server.host.encode(), server.port)
     status = raw_request(server, request, timeout=5)
     elapsed = time.monotonic() - start
-    check("/api/info beside 20 slow clients: answered in under 1 s",
-          status == 200 and elapsed < 1.0, "(%d after %.2f s)" % (status, elapsed))
+    # Without a thread per connection there was no answer at all (the request timed out);
+    # the bound leaves room for the sanitizer build on a loaded machine.
+    check("/api/info beside 20 slow clients: answered in under 3 s",
+          status == 200 and elapsed < 3.0, "(%d after %.2f s)" % (status, elapsed))
+    print("/api/info answered in %.3f s beside 20 slow clients" % elapsed)
     return release
 
 
@@ -252,9 +255,12 @@ def main():
         code = server.stop()
         stop_seconds = time.monotonic() - stop_start
     check("SIGTERM exits 0", code == 0, "(exit %s; stderr %s)" % (code, server.proc.stderr.read()))
-    # The slow clients are still connected: their sockets are shut down after a grace period.
-    check("SIGTERM with 20 slow clients connected exits within 3 s", stop_seconds < 3.0,
+    # The slow clients are still connected: their sockets are shut down after a 0.5 s grace
+    # period (without that, SIGTERM waited 30 s for them; the bound leaves room for the
+    # sanitizer build's exit-time leak check).
+    check("SIGTERM with 20 slow clients connected exits within 8 s", stop_seconds < 8.0,
           "(%.2f s)" % stop_seconds)
+    print("stopped in %.2f s with 20 slow clients connected" % stop_seconds)
     release_slow()
     check("prints how many requests it served",
           any("stopped after" in line for line in server.lines), "".join(server.lines))
