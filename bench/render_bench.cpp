@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] "
                  "[--mesh M] [--frames F] [--width W] [--height H] [--gl osmesa|egl] "
-                 "[--gl-device N]\n");
+                 "[--gl-device N] [--accumulation auto|rgba32f|rgba16f]\n");
     return 2;
   }
   std::string compressed = argv[1], transfer_path, mesh_path,
@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   int frames = 15, width = 1280, height = 948;
+  render::Accumulation accumulation = render::Accumulation::kAuto;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
     if (flag == "--transfer")
@@ -116,6 +117,13 @@ int main(int argc, char** argv) {
         return 2;
       }
       gl.device = int(n);
+    } else if (flag == "--accumulation") {
+      try {
+        accumulation = render::parse_accumulation(value);
+      } catch (const std::invalid_argument& e) {
+        std::fprintf(stderr, "render_bench: --accumulation: %s\n", e.what());
+        return 2;
+      }
     } else if (flag == "--frames")
       frames = std::atoi(value.c_str());
     else if (flag == "--width")
@@ -147,8 +155,9 @@ int main(int argc, char** argv) {
     }
     render::GlContext context(gl);
     const render::GlInfo gl_info = context.info();
-    std::printf("render_bench: %s, %s, %s\n", context.description().c_str(),
-                gl_info.renderer.c_str(), gl_info.version.c_str());
+    std::printf("render_bench: %s, %s, %s, %s accumulation\n", context.description().c_str(),
+                gl_info.renderer.c_str(), gl_info.version.c_str(),
+                render::accumulation_name(render::resolve_accumulation(accumulation)));
     std::printf(
         "render_bench: %s, %zu vertices, %zu triangles, %d clusters x %d PCs, order %d, "
         "%d x %d, %d frames (median)\n",
@@ -226,6 +235,7 @@ int main(int argc, char** argv) {
         }
         const std::string name = std::string(row.name) + (feedback ? "" : ", in-draw");
         render::RendererOptions o;
+        o.accumulation = accumulation;
         o.multipass_feedback = feedback;
         o.mode = row.mode;
         o.clusters_per_pass = row.clusters_per_pass;

@@ -372,6 +372,35 @@ TEST(Renderer, MultipassEqualsSinglepassForOneTwoAndManyPasses) {
   EXPECT_LT(covered, single.width * single.height);
 }
 
+TEST(Renderer, HalfFloatAccumulationKeepsElevenBits) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 4, 12, 4);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  const Eigen::Matrix3d R = test_rotation();
+  // One cluster per pass: the most additions into the target.
+  render::RendererOptions o = options(render::Mode::kMultipass, registers);
+  render::RenderStats stats;
+  o.accumulation = render::Accumulation::kAuto;
+  render_once(ctx, s, o, s.camera, R, &stats);
+  EXPECT_EQ(stats.accumulation, render::Accumulation::kFloat32) << "kAuto on llvmpipe";
+  o.accumulation = render::Accumulation::kFloat32;
+  const render::Image full = render_once(ctx, s, o, s.camera, R);
+  o.accumulation = render::Accumulation::kFloat16;
+  const render::Image half = render_once(ctx, s, o, s.camera, R, &stats);
+  EXPECT_EQ(stats.accumulation, render::Accumulation::kFloat16);
+  ASSERT_GT(stats.passes, 2);
+  // Each of the passes' sums rounds to 11 significant bits: 2^-11 relative per addition.
+  double worst = 0;
+  bool differs = false;
+  for (std::size_t i = 0; i < full.rgba.size(); ++i) {
+    const double ref = full.rgba[i], got = half.rgba[i];
+    worst = std::max(worst, std::abs(got - ref) / std::max(std::abs(ref), 1e-3));
+    differs = differs || got != ref;
+  }
+  EXPECT_LT(worst, double(stats.passes) * std::ldexp(1.0, -11));
+  EXPECT_TRUE(differs) << "the half-float target was not used";
+}
+
 TEST(Renderer, DecoupledCpuAndSinglepassImagesAgree) {
   render::GlContext ctx;
   const Scene s = make_scene(meshes::make_torus(1.f, 0.4f, 24, 12), 5, 10, 4);

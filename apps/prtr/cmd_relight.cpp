@@ -82,7 +82,7 @@ struct Options {
   int supersample = kDefaultSupersample;
   double degrees = 360.0;
   bool quiet = false, no_video = false;
-  std::string exr_pixels = "half";
+  std::string exr_pixels = "half", accumulation = "auto";
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
@@ -110,6 +110,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_view_flags(cmd, o.view);
   add_supersample_flag(cmd, o.supersample);
   add_gl_flags(cmd, o.gl);
+  add_accumulation_flag(cmd, o.accumulation);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--columns", o.columns, "Contact sheet columns")
       ->check(integer_in(1, 64))
@@ -172,6 +173,7 @@ std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::
                                                 const render::GlContext& context) {
   render::RendererOptions ro;
   ro.mode = render::parse_mode(o.mode);
+  ro.accumulation = render::parse_accumulation(o.accumulation);
   ro.register_budget = o.register_budget;
   try {
     if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)

@@ -44,7 +44,7 @@ std::string count_list(const std::vector<std::uint64_t>& values) {
 
 struct Options {
   std::string compressed, probe, mesh, transfer, output, png, mode = "multipass";
-  std::string strategy = "order";
+  std::string strategy = "order", accumulation = "auto";
   ViewFlags view;
   GlFlags gl;
   MeshFlags mesh_flags;
@@ -97,6 +97,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_flag("--no-reorder", o.no_reorder,
                 "Keep triangles in mesh order (no vertex-cache order)");
   add_gl_flags(cmd, o.gl);
+  add_accumulation_flag(cmd, o.accumulation);
   cmd->add_flag("--json", o.json, "Print one JSON line of results");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors (and the --json line)");
 }
@@ -105,6 +106,7 @@ void add_flags(CLI::App* cmd, Options& o) {
 render::RendererOptions renderer_options(const Options& o, const CLI::App* cmd) {
   render::RendererOptions ro;
   ro.mode = render::parse_mode(o.mode);
+  ro.accumulation = render::parse_accumulation(o.accumulation);
   ro.register_budget = o.register_budget;
   ro.clusters_per_pass = o.clusters_per_pass;
   ro.cull_back_faces = !o.no_cull;
@@ -177,9 +179,10 @@ void print_report(const Options& o, const render::RenderStats& st,
     std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
                 o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
     std::printf(
-        "mode        %s, %d pass(es), %d cluster(s) per pass, budget %d vec4 (%d per cluster)\n",
+        "mode        %s, %d pass(es), %d cluster(s) per pass, budget %d vec4 (%d per cluster), "
+        "%s target\n",
         o.mode.c_str(), st.passes, st.clusters_per_pass, st.register_budget,
-        st.registers_per_cluster);
+        st.registers_per_cluster, render::accumulation_name(st.accumulation));
     std::printf("overdraw    %.4f (%llu triangles, drawn per pass %s)\n", st.average_overdraw,
                 static_cast<unsigned long long>(st.triangle_count),
                 count_list(st.triangles_per_pass).c_str());
@@ -206,6 +209,7 @@ void print_report(const Options& o, const render::RenderStats& st,
                  {"gl_ms", timing.gl_ms_median}};
     add_work(line, st.pass_work);
     line["supersample"] = o.supersample;
+    line["accumulation"] = render::accumulation_name(st.accumulation);
     line["image_frame_ms"] = image_ms;
     line["downsample_ms"] = downsample_ms;
     std::printf("%s\n", dump_json(line).c_str());

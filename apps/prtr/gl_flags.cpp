@@ -24,6 +24,15 @@ void add_gl_flags(CLI::App* cmd, GlFlags& flags) {
       ->check(integer_in(0, 1 << 20));
 }
 
+void add_accumulation_flag(CLI::App* cmd, std::string& name) {
+  cmd->add_option("--accumulation", name,
+                  "Format the passes add into: rgba32f, rgba16f (six times the blending rate "
+                  "on a GPU, 11 significant bits), or auto (rgba16f on a GPU, rgba32f on "
+                  "Mesa's software rasterisers)")
+      ->check(CLI::IsMember({"auto", "rgba32f", "rgba16f"}))
+      ->capture_default_str();
+}
+
 render::GlSelection gl_selection(const GlFlags& flags) {
   render::GlSelection s;
   const auto backend = render::parse_gl_backend(flags.backend);

@@ -14,15 +14,15 @@ FrameTarget::~FrameTarget() {
   glDeleteRenderbuffers(1, &depth_);
 }
 
-void FrameTarget::bind(int width, int height) {
-  if (!fbo_ || width != width_ || height != height_) {
+void FrameTarget::bind(int width, int height, bool half) {
+  if (!fbo_ || width != width_ || height != height_ || half != half_) {
     if (!fbo_) {
       glGenFramebuffers(1, &fbo_);
       glGenRenderbuffers(1, &colour_);
       glGenRenderbuffers(1, &depth_);
     }
     glBindRenderbuffer(GL_RENDERBUFFER, colour_);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, width, height);
+    glRenderbufferStorage(GL_RENDERBUFFER, half ? GL_RGBA16F : GL_RGBA32F, width, height);
     glBindRenderbuffer(GL_RENDERBUFFER, depth_);
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
@@ -36,6 +36,7 @@ void FrameTarget::bind(int width, int height) {
     check_gl("Renderer: framebuffer");
     width_ = width;
     height_ = height;
+    half_ = half;
   }
   glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
   glViewport(0, 0, width, height);

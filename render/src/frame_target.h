@@ -16,7 +16,8 @@ class FrameTarget {
 
   // Binds the framebuffer at this size (allocating it first when the size changed) and sets
   // the viewport. GlError when the driver cannot provide it.
-  void bind(int width, int height);
+  // `half`: RGBA16F colour instead of RGBA32F (a change reallocates).
+  void bind(int width, int height, bool half = false);
   bool empty() const { return fbo_ == 0; }
   // The colour buffer, row 0 at the top.
   Image read() const;
@@ -27,6 +28,7 @@ class FrameTarget {
  private:
   GLuint fbo_ = 0, colour_ = 0, depth_ = 0;
   int width_ = 0, height_ = 0;
+  bool half_ = false;
 };
 
 }  // namespace render

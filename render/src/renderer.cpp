@@ -90,6 +90,17 @@ RenderStats initial_stats(const meshes::Mesh& mesh) {
 
 }  // namespace
 
+// kAuto: half floats on a hardware GPU; Mesa's software rasterisers (llvmpipe, softpipe)
+// gain nothing from them.
+Accumulation resolve_accumulation(Accumulation wanted) {
+  if (wanted != Accumulation::kAuto) return wanted;
+  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string renderer = name != nullptr ? name : "";
+  const bool software = renderer.find("llvmpipe") != std::string::npos ||
+                        renderer.find("softpipe") != std::string::npos;
+  return software ? Accumulation::kFloat32 : Accumulation::kFloat16;
+}
+
 Renderer::Impl::Impl(const meshes::Mesh& mesh, const cpca::CompressedSet* set,
                      const prt::TransferSet* transfer, const probes::Probe* probe,
                      const RendererOptions& renderer_options)
@@ -101,6 +112,7 @@ Renderer::Impl::Impl(const meshes::Mesh& mesh, const cpca::CompressedSet* set,
   rotation = prt::ShRotation(order, Eigen::Matrix3d::Identity());
   lit.resize(order * order, 3);
   background.use_probe = background_pass.has_probe();
+  stats.accumulation = resolve_accumulation(options.accumulation);
   check_gl("Renderer: set-up");
 }
 
@@ -117,7 +129,7 @@ void Renderer::Impl::update(const Camera& camera, const Eigen::Ref<const prt::Sh
 }
 
 void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_matrix) {
-  target.bind(camera.width, camera.height);
+  target.bind(camera.width, camera.height, stats.accumulation == Accumulation::kFloat16);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
   // A solid background is the clear colour (alpha 0: not coverage); the multipass pre-pass
@@ -277,6 +289,25 @@ TimingSummary measure(Renderer& renderer, const Camera& camera,
   s.gl_ms_median = median(gl);
   s.fps = s.frame_ms_median > 0 ? 1000.0 / s.frame_ms_median : 0.0;
   return s;
+}
+
+const char* accumulation_name(Accumulation a) {
+  switch (a) {
+    case Accumulation::kAuto:
+      return "auto";
+    case Accumulation::kFloat32:
+      return "rgba32f";
+    case Accumulation::kFloat16:
+      return "rgba16f";
+  }
+  return "?";
+}
+
+Accumulation parse_accumulation(const std::string& name) {
+  for (Accumulation a : {Accumulation::kAuto, Accumulation::kFloat32, Accumulation::kFloat16})
+    if (name == accumulation_name(a)) return a;
+  throw std::invalid_argument("unknown accumulation format '" + name +
+                              "'; use auto, rgba32f or rgba16f");
 }
 
 }  // namespace render

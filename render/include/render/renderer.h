@@ -51,8 +51,20 @@ const char* mode_name(Mode mode);  // "multipass", ...; "unknown" out of range
 Mode parse_mode(const std::string& name);
 std::vector<std::string> mode_names();
 
+// The colour target the passes add into. On a GPU, additive blending into RGBA32F runs at a
+// sixth of RGBA16F's rate (0.99 against 6.3 G fragments/s measured on an H200), which bounds
+// the thesis configuration near 300 FPS; half floats keep 11 significant bits, an error
+// measured in docs/BENCHMARKS.md. On Mesa's software rasterisers the formats cost the same,
+// so kAuto keeps 32-bit floats there and takes half floats on a hardware GPU.
+enum class Accumulation { kAuto, kFloat32, kFloat16 };
+const char* accumulation_name(Accumulation a);             // "auto", "rgba32f", "rgba16f"
+Accumulation parse_accumulation(const std::string& name);  // std::invalid_argument if unknown
+// What `wanted` means in the current GL context (kAuto resolved by its renderer's name).
+Accumulation resolve_accumulation(Accumulation wanted);
+
 struct RendererOptions {
   Mode mode = Mode::kMultipass;
+  Accumulation accumulation = Accumulation::kAuto;
   // vec4 registers a pass may use; 0 = what the context offers
   // (GlInfo::default_register_budget).
   int register_budget = 0;
@@ -115,6 +127,7 @@ struct RenderStats {
   double average_overdraw = 1.0;
   std::uint64_t triangle_count = 0;
   std::uint64_t vertex_count = 0;
+  Accumulation accumulation = Accumulation::kFloat32;  // as resolved for this context
 };
 
 class Renderer {
