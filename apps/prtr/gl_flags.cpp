@@ -2,6 +2,7 @@
 
 #include "commands.h"
 #include "flag_checks.h"
+#include "render/renderer.h"
 
 namespace prtr_app {
 
@@ -29,7 +30,7 @@ void add_accumulation_flag(CLI::App* cmd, std::string& name) {
                   "Format the passes add into: rgba32f, rgba16f (six times the blending rate "
                   "on a GPU, 11 significant bits), or auto (rgba16f on a GPU, rgba32f on "
                   "Mesa's software rasterisers)")
-      ->check(CLI::IsMember({"auto", "rgba32f", "rgba16f"}))
+      ->check(CLI::IsMember(render::accumulation_names()))
       ->capture_default_str();
 }
 

@@ -32,6 +32,11 @@ constexpr common::EnumName<Mode> kModeNames[] = {{Mode::kMultipass, "multipass"}
                                                  {Mode::kUncompressed, "uncompressed"},
                                                  {Mode::kCpu, "cpu"}};
 
+constexpr common::EnumName<Accumulation> kAccumulationNames[] = {
+    {Accumulation::kAuto, "auto"},
+    {Accumulation::kFloat32, "rgba32f"},
+    {Accumulation::kFloat16, "rgba16f"}};
+
 }  // namespace
 
 const char* mode_name(Mode mode) {
@@ -44,6 +49,18 @@ Mode parse_mode(const std::string& name) {
 
 std::vector<std::string> mode_names() {
   return common::enum_names<Mode>(kModeNames);
+}
+
+const char* accumulation_name(Accumulation a) {
+  return common::enum_name<Accumulation>(kAccumulationNames, a);
+}
+
+Accumulation parse_accumulation(const std::string& name) {
+  return common::parse_enum<Accumulation>(kAccumulationNames, name, "accumulation format");
+}
+
+std::vector<std::string> accumulation_names() {
+  return common::enum_names<Accumulation>(kAccumulationNames);
 }
 
 // What every path shares: the SH rotation, the framebuffer, the background and the
@@ -289,25 +306,6 @@ TimingSummary measure(Renderer& renderer, const Camera& camera,
   s.gl_ms_median = median(gl);
   s.fps = s.frame_ms_median > 0 ? 1000.0 / s.frame_ms_median : 0.0;
   return s;
-}
-
-const char* accumulation_name(Accumulation a) {
-  switch (a) {
-    case Accumulation::kAuto:
-      return "auto";
-    case Accumulation::kFloat32:
-      return "rgba32f";
-    case Accumulation::kFloat16:
-      return "rgba16f";
-  }
-  return "?";
-}
-
-Accumulation parse_accumulation(const std::string& name) {
-  for (Accumulation a : {Accumulation::kAuto, Accumulation::kFloat32, Accumulation::kFloat16})
-    if (name == accumulation_name(a)) return a;
-  throw std::invalid_argument("unknown accumulation format '" + name +
-                              "'; use auto, rgba32f or rgba16f");
 }
 
 }  // namespace render

@@ -2,6 +2,7 @@
 
 #include "common/enum_names.h"
 #include "cpca/supercluster_strategy.h"
+#include "render/pass_capacity.h"
 
 #include <algorithm>
 #include <cctype>
@@ -204,23 +205,30 @@ std::vector<std::string> view_parameter_names() {
 
 namespace {
 
-// The budget and clusters per pass, in the page's words: what must hold for a pass to
-// fit, and which values would (the renderer's own check names command-line flags).
+// The budget and clusters per pass, in the page's words: render::check_pass_capacity
+// decides (the renderer's own refusal names command-line flags), this says which values
+// would fit.
 void check_passes(const ViewState& state, const ViewLimits& limits) {
-  const int per_cluster = std::max(1, limits.registers_per_cluster);
-  const int budget = state.register_budget > 0 ? state.register_budget : limits.max_register_budget;
-  if (state.register_budget > 0 && state.register_budget < per_cluster)
-    throw RequestError(
-        "budget=" + std::to_string(state.register_budget) + ": below one cluster's " +
-        std::to_string(per_cluster) + " registers; use 0 (the context's " +
-        std::to_string(limits.max_register_budget) + ") or " + std::to_string(per_cluster) +
-        " to " + std::to_string(limits.max_register_budget));
-  const int fit = budget / per_cluster;
-  if (state.clusters_per_pass > fit)
-    throw RequestError("cpp=" + std::to_string(state.clusters_per_pass) + ": " +
-                       std::to_string(fit) + " clusters fit the budget of " +
-                       std::to_string(budget) + " registers; use 0 (all that fit) or 1 to " +
-                       std::to_string(fit));
+  const render::PassCapacity c =
+      render::check_pass_capacity(std::max(1, limits.registers_per_cluster), state.register_budget,
+                                  limits.max_register_budget, state.clusters_per_pass);
+  const std::string context = std::to_string(limits.max_register_budget);
+  switch (c.problem) {
+    case render::CapacityProblem::kNone:
+      return;
+    case render::CapacityProblem::kBudgetAboveContext:  // the parser's range already refuses it
+    case render::CapacityProblem::kBudgetBelowCluster:
+      throw RequestError("budget=" + std::to_string(state.register_budget) +
+                         ": below one cluster's " + std::to_string(c.registers_per_cluster) +
+                         " registers; use 0 (the context's " + context + ") or " +
+                         std::to_string(c.registers_per_cluster) + " to " + context);
+    case render::CapacityProblem::kTooManyPerPass:
+      throw RequestError("cpp=" + std::to_string(state.clusters_per_pass) + ": " +
+                         std::to_string(c.clusters_per_pass) + " clusters fit the budget of " +
+                         std::to_string(c.register_budget) +
+                         " registers; use 0 (all that fit) or 1 to " +
+                         std::to_string(c.clusters_per_pass));
+  }
 }
 
 }  // namespace

@@ -59,6 +59,7 @@ std::vector<std::string> mode_names();
 enum class Accumulation { kAuto, kFloat32, kFloat16 };
 const char* accumulation_name(Accumulation a);             // "auto", "rgba32f", "rgba16f"
 Accumulation parse_accumulation(const std::string& name);  // std::invalid_argument if unknown
+std::vector<std::string> accumulation_names();
 // What `wanted` means in the current GL context (kAuto resolved by its renderer's name).
 Accumulation resolve_accumulation(Accumulation wanted);
 
