@@ -256,6 +256,62 @@ void print_probe_errors(const std::vector<probes::Probe>& probes_in, int order,
   std::fflush(stdout);
 }
 
+// The row that keeps SH only on the light side (the view side exact): what the method's view
+// projection costs, apart from its light-side truncation.
+void print_exact_view_side(const meshes::Mesh& sphere, const prt::Material& material, int order,
+                           const std::vector<probes::Probe>& probes_in,
+                           const std::vector<std::vector<Eigen::Vector3d>>& exact,
+                           const std::vector<View>& views, const std::vector<int>& angles) {
+  prt::BakeOptions o;
+  o.order = order;
+  o.samples = kSamples;
+  o.bounces = 0;
+  o.material = material;
+  o.brdf_override = Eigen::MatrixXd::Identity(order * order, order * order);
+  const prt::TransferSet light = prt::bake(sphere, o);
+  const ExactViewSide exact_view(order);
+  std::printf("| exact view side | %d | | | |", order);
+  print_probe_errors(probes_in, order, exact, views, angles, [&](const prt::ShLighting& l) {
+    return light_side_only(exact_view, light, sphere, material, l, views);
+  });
+}
+
+void print_table_header(const std::string& material, const std::vector<probes::Probe>& probes_in) {
+  std::printf("## %s\n\n", material.c_str());
+  std::printf("| fit | order | white sky: at 0 deg | p99 abs 0-70 deg | max abs |");
+  for (std::size_t q = 0; q < probes_in.size(); ++q)
+    std::printf(" %s rel. RMSE | bias |", probes_in[q].name().c_str());
+  std::printf(" rel. RMSE by angle %s (0/15/30/45/60/75) |\n", probes_in[0].name().c_str());
+  std::printf("| --- | ---: | ---: | ---: | ---: |");
+  for (std::size_t q = 0; q < probes_in.size(); ++q) std::printf(" ---: | ---: |");
+  std::printf(" --- |\n");
+}
+
+// A row's white-sky columns: the error of the radiance toward each angle from the sphere's
+// pole vertex (any vertex would do: the sky is uniform) against the directional albedo.
+void print_white_sky(const prt::TransferSet& t, const meshes::Mesh& sphere, prt::ViewFit fit,
+                     const std::vector<int>& sky_angles, const std::vector<double>& albedo) {
+  // White sky: l = sqrt(4 pi) e_0 in every channel.
+  prt::ShLighting white = prt::ShLighting::Zero(t.order * t.order, 3);
+  white.row(0).setConstant(std::sqrt(4.0 * kPi));
+  std::vector<double> sky_err;
+  const std::size_t pole = 0;
+  const Eigen::Vector3d n = sphere.normals[pole].cast<double>();
+  const Eigen::Vector3d tan = sphere.tangents[pole].cast<double>();
+  for (std::size_t i = 0; i < sky_angles.size(); ++i) {
+    const double th = sky_angles[i] * kPi / 180.0;
+    const Eigen::Vector3d w = std::cos(th) * n + std::sin(th) * tan;
+    const double x = radiance(t, sphere, pole, fit, white, w.normalized())[0];
+    sky_err.push_back((x - albedo[i]) / albedo[i]);
+  }
+  std::vector<double> abs_err;
+  for (double e : sky_err) abs_err.push_back(std::abs(e));
+  std::sort(abs_err.begin(), abs_err.end());
+  const double p99 = abs_err[std::size_t(std::floor(0.99 * double(abs_err.size() - 1)))];
+  std::printf("| %s | %d | %+.2f%% | %.2f%% | %.2f%% |", prt::kViewFitNames.name(fit), t.order,
+              100 * sky_err[0], 100 * p99, 100 * abs_err.back());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -268,7 +324,7 @@ int main(int argc, char** argv) {
     if (a == "--quick") {
       quick = true;
     } else if (a == "--fit" && i + 1 < argc) {
-      fits = {prt::parse_view_fit(argv[++i])};
+      fits = {prt::kViewFitNames.parse(argv[++i])};
     } else if (a == "--lambda" && i + 1 < argc) {
       lambda = std::atof(argv[++i]);
     } else if (!a.empty() && a[0] == '-') {
@@ -310,51 +366,14 @@ int main(int argc, char** argv) {
     for (const probes::Probe& probe : probes_in)
       exact.push_back(exact_probe(probe, sphere, nm.material, views));
 
-    std::printf("## %s\n\n", nm.name.c_str());
-    std::printf("| fit | order | white sky: at 0 deg | p99 abs 0-70 deg | max abs |");
-    for (std::size_t q = 0; q < probes_in.size(); ++q)
-      std::printf(" %s rel. RMSE | bias |", probes_in[q].name().c_str());
-    std::printf(" rel. RMSE by angle %s (0/15/30/45/60/75) |\n", probes_in[0].name().c_str());
-    std::printf("| --- | ---: | ---: | ---: | ---: |");
-    for (std::size_t q = 0; q < probes_in.size(); ++q) std::printf(" ---: | ---: |");
-    std::printf(" --- |\n");
-    for (int order : orders) {
-      if (order != 6 && order != 10) continue;
-      prt::BakeOptions o;
-      o.order = order;
-      o.samples = kSamples;
-      o.bounces = 0;
-      o.material = nm.material;
-      o.brdf_override = Eigen::MatrixXd::Identity(order * order, order * order);
-      const prt::TransferSet light = prt::bake(sphere, o);
-      const ExactViewSide exact_view(order);
-      std::printf("| exact view side | %d | | | |", order);
-      print_probe_errors(probes_in, order, exact, views, angles, [&](const prt::ShLighting& l) {
-        return light_side_only(exact_view, light, sphere, nm.material, l, views);
-      });
-    }
+    print_table_header(nm.name, probes_in);
+    for (int order : orders)
+      if (order == 6 || order == 10)
+        print_exact_view_side(sphere, nm.material, order, probes_in, exact, views, angles);
     for (prt::ViewFit fit : fits) {
       for (int order : orders) {
         const prt::TransferSet t = bake_sphere(sphere, nm.material, order, fit, lambda);
-        // White sky: l = sqrt(4 pi) e_0 in every channel.
-        prt::ShLighting white = prt::ShLighting::Zero(order * order, 3);
-        white.row(0).setConstant(std::sqrt(4.0 * kPi));
-        std::vector<double> sky_err;
-        const std::size_t pole = 0;
-        const Eigen::Vector3d n = sphere.normals[pole].cast<double>();
-        const Eigen::Vector3d tan = sphere.tangents[pole].cast<double>();
-        for (std::size_t i = 0; i < sky_angles.size(); ++i) {
-          const double th = sky_angles[i] * kPi / 180.0;
-          const Eigen::Vector3d w = std::cos(th) * n + std::sin(th) * tan;
-          const double x = radiance(t, sphere, pole, fit, white, w.normalized())[0];
-          sky_err.push_back((x - albedo[i]) / albedo[i]);
-        }
-        std::vector<double> abs_err;
-        for (double e : sky_err) abs_err.push_back(std::abs(e));
-        std::sort(abs_err.begin(), abs_err.end());
-        const double p99 = abs_err[std::size_t(std::floor(0.99 * double(abs_err.size() - 1)))];
-        std::printf("| %s | %d | %+.2f%% | %.2f%% | %.2f%% |", prt::view_fit_name(fit), order,
-                    100 * sky_err[0], 100 * p99, 100 * abs_err.back());
+        print_white_sky(t, sphere, fit, sky_angles, albedo);
         print_probe_errors(probes_in, order, exact, views, angles, [&](const prt::ShLighting& l) {
           std::vector<Eigen::Vector3d> x(views.size());
           for (std::size_t i = 0; i < views.size(); ++i)

@@ -73,236 +73,284 @@ void print_targets(const std::vector<Sample>& multipass_3, const Sample& thesis,
         thesis.cpu_ms / floor.cpu_ms);
 }
 
-}  // namespace
+// A flag the benchmark cannot use: exit 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
-int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr,
-                 "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] "
-                 "[--mesh M] [--frames F] [--width W] [--height H] [--gl osmesa|egl] "
-                 "[--gl-device N] [--accumulation auto|rgba32f|rgba16f]\n");
-    return 2;
-  }
-  std::string compressed = argv[1], transfer_path, mesh_path,
-              probe_path = "/usr/share/blender/datafiles/studiolights/world/forest.exr";
+struct Args {
+  std::string compressed, transfer, mesh;
+  std::string probe = "/usr/share/blender/datafiles/studiolights/world/forest.exr";
   render::GlSelection gl;
-  try {
-    gl = render::gl_selection_from_environment();  // PRTR_GL, PRTR_GL_DEVICE; flags beat it
-  } catch (const render::GlError& e) {
-    std::fprintf(stderr, "render_bench: %s\n", e.what());
-    return 2;
-  }
   int frames = 15, width = 1280, height = 948;
   render::Accumulation accumulation = render::Accumulation::kAuto;
+};
+
+Args parse_args(int argc, char** argv) {
+  if (argc < 2)
+    throw UsageError(
+        "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] "
+        "[--mesh M] [--frames F] [--width W] [--height H] [--gl osmesa|egl] "
+        "[--gl-device N] [--accumulation auto|rgba32f|rgba16f]");
+  Args a;
+  a.compressed = argv[1];
+  try {
+    a.gl = render::gl_selection_from_environment();  // PRTR_GL, PRTR_GL_DEVICE; flags beat it
+  } catch (const render::GlError& e) {
+    throw UsageError(e.what());
+  }
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i], value = argv[i + 1];
-    if (flag == "--transfer")
-      transfer_path = value;
-    else if (flag == "--probe")
-      probe_path = value;
-    else if (flag == "--mesh")  // the set's mesh elsewhere (the GPU bundle carries its own)
-      mesh_path = value;
-    else if (flag == "--gl") {
+    if (flag == "--transfer") {
+      a.transfer = value;
+    } else if (flag == "--probe") {
+      a.probe = value;
+    } else if (flag == "--mesh") {  // the set's mesh elsewhere (the GPU bundle carries its own)
+      a.mesh = value;
+    } else if (flag == "--gl") {
       const auto backend = render::parse_gl_backend(value);
-      if (!backend) {
-        std::fprintf(stderr, "render_bench: --gl %s: use osmesa or egl\n", value.c_str());
-        return 2;
-      }
-      gl.backend = *backend;
+      if (!backend) throw UsageError("--gl " + value + ": use osmesa or egl");
+      a.gl.backend = *backend;
     } else if (flag == "--gl-device") {
       char* end = nullptr;
       const long n = std::strtol(value.c_str(), &end, 10);
-      if (*end || n < 0 || n > 1000) {
-        std::fprintf(stderr, "render_bench: --gl-device %s is not a device index\n", value.c_str());
-        return 2;
-      }
-      gl.device = int(n);
+      if (*end || n < 0 || n > 1000)
+        throw UsageError("--gl-device " + value + " is not a device index");
+      a.gl.device = int(n);
     } else if (flag == "--accumulation") {
       try {
-        accumulation = render::parse_accumulation(value);
+        a.accumulation = render::kAccumulationNames.parse(value);
       } catch (const std::invalid_argument& e) {
-        std::fprintf(stderr, "render_bench: --accumulation: %s\n", e.what());
-        return 2;
+        throw UsageError(std::string("--accumulation: ") + e.what());
       }
-    } else if (flag == "--frames")
-      frames = std::atoi(value.c_str());
-    else if (flag == "--width")
-      width = std::atoi(value.c_str());
-    else if (flag == "--height")
-      height = std::atoi(value.c_str());
-    else {
-      std::fprintf(stderr, "render_bench: unknown flag %s\n", flag.c_str());
-      return 2;
+    } else if (flag == "--frames") {
+      a.frames = std::atoi(value.c_str());
+    } else if (flag == "--width") {
+      a.width = std::atoi(value.c_str());
+    } else if (flag == "--height") {
+      a.height = std::atoi(value.c_str());
+    } else {
+      throw UsageError("unknown flag " + flag);
     }
   }
+  return a;
+}
+
+// What every configuration renders: the set, its mesh, the probe and the framing camera.
+struct Scene {
+  cpca::CompressedSet set;
+  meshes::Mesh mesh;
+  std::optional<prt::TransferSet> transfer;
+  probes::Probe probe;
+  prt::ShLighting lighting;
+  render::Camera camera;
+};
+
+Scene load_scene(const Args& a) {
+  Scene s;
+  s.set = cpca::read_compressed(a.compressed);
+  s.mesh = meshes::load_mesh(a.mesh.empty() ? s.set.mesh_path : a.mesh);
+  if (!a.transfer.empty()) s.transfer = prt::read_transfer(a.transfer);
+  s.probe = load_bench_probe(a.probe);
+  s.lighting = prt::project(s.probe, s.set.order);
+  const meshes::Bounds b = meshes::bounds(s.mesh);
+  double radius = 0;
+  for (const auto& p : s.mesh.positions) radius = std::max(radius, double((p - b.center()).norm()));
+  s.camera = render::frame_sphere(b.center().cast<double>(), radius, a.width, a.height);
+  return s;
+}
+
+void print_work(const std::vector<render::PassWork>& work) {
+  const render::WorkTotals w = render::work_totals(work);
+  std::printf(" %9llu %9llu %6.3f %10llu\n", (unsigned long long)w.vs_invocations,
+              (unsigned long long)w.referenced_vertices, w.vs_per_referenced_vertex,
+              (unsigned long long)w.fs_invocations);
+}
+
+// The trivial-shader floors every row is a ratio to. They draw into the renderer's framebuffer
+// format; "+ background" also runs the renderer's probe background pass, so a path's ratio to
+// it compares like with like.
+struct Floors {
+  double ms = 0, background_ms = 0, cpu_ms = 0;
+};
+
+Floors measure_floors(const Scene& s, int frames) {
+  std::vector<render::PassWork> floor_work, floor_bg_work;
+  Floors f;
+  f.ms = render::floor_frame_ms(s.mesh, s.camera, {true, true, frames, 3, nullptr, &floor_work});
+  f.background_ms =
+      render::floor_frame_ms(s.mesh, s.camera, {true, true, frames, 3, &s.probe, &floor_bg_work});
+  const double plain = render::floor_frame_ms(s.mesh, s.camera, {false, false, frames, 3});
+  // The floors' process CPU per frame: a run of 5F frames less a run of F, so the
+  // harness's setup (index order, compile, probe upload) and any first-frame cost cancel.
+  auto floor_cpu_ms = [&](const probes::Probe* bg) {
+    auto run_cpu = [&](int n) {
+      const double c0 = process_cpu_ms();
+      render::floor_frame_ms(s.mesh, s.camera, {true, true, n, 1, bg});
+      return process_cpu_ms() - c0;
+    };
+    const double few = run_cpu(frames);
+    return (run_cpu(5 * frames) - few) / (4 * frames);
+  };
+  f.cpu_ms = floor_cpu_ms(nullptr);
+  const double bg_cpu = floor_cpu_ms(&s.probe);
+  std::printf("%-28s %6s %8s %7s %8s %7s %7s %6s %6s %8s %9s %9s %6s %10s\n", "configuration",
+              "passes", "overdraw", "FPS", "frame ms", "cpu ms", "gl ms", "/floor", "/fl+bg",
+              "proc cpu", "VS inv", "ref verts", "VS/ref", "FS inv");
+  std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f %8.2f",
+              "floor (trivial, cull+order)", 1, 1.0, 1000.0 / f.ms, f.ms, "-", "-", 1.0,
+              f.ms / f.background_ms, f.cpu_ms);
+  print_work(floor_work);
+  std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f %8.2f", "floor + background", 1, 1.0,
+              1000.0 / f.background_ms, f.background_ms, "-", "-", f.background_ms / f.ms, 1.0,
+              bg_cpu);
+  print_work(floor_bg_work);
+  std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f\n", "floor (trivial, plain)", 1, 1.0,
+              1000.0 / plain, plain, "-", "-", plain / f.ms, plain / f.background_ms);
+  return f;
+}
+
+struct Row {
+  const char* name;
+  render::Mode mode;
+  int clusters_per_pass;
+  const char* strategy = nullptr;  // cpca::group_clusters name; null: cluster order
+};
+
+// The thesis configuration is the ILS row: 3 clusters per pass grouped by ILS.
+const Row kRows[] = {{"multipass, context budget", render::Mode::kMultipass, 0},
+                     {"multipass, 16 clusters/pass", render::Mode::kMultipass, 16},
+                     {"multipass, 3 clusters/pass", render::Mode::kMultipass, 3},
+                     {"multipass, 3/pass, ILS", render::Mode::kMultipass, 3, "ils"},
+                     {"decoupled, 3 clusters/pass", render::Mode::kDecoupled, 3},
+                     {"single-pass (SSBO)", render::Mode::kSinglepass, 0},
+                     {"uncompressed", render::Mode::kUncompressed, 0},
+                     {"cpu-shaded", render::Mode::kCpu, 0}};
+
+using PassDetails = std::vector<std::pair<std::string, std::vector<render::PassWork>>>;
+
+// One row (feedback: multipass shading by feedback, the default; else in the triangle draws),
+// printed; nullopt when the context cannot run it. Its pass work goes to `details`.
+std::optional<Sample> run_row(const Scene& s, const Args& a, const Floors& floors, const Row& row,
+                              bool feedback, PassDetails& details) {
+  const std::string name = std::string(row.name) + (feedback ? "" : ", in-draw");
+  render::RendererOptions o;
+  o.accumulation = a.accumulation;
+  o.multipass_feedback = feedback;
+  o.mode = row.mode;
+  o.clusters_per_pass = row.clusters_per_pass;
+  if (row.strategy) {
+    std::vector<cpca::TriangleIndices> tris(s.mesh.triangles.begin(), s.mesh.triangles.end());
+    o.groups = cpca::group_clusters(
+        row.strategy, {s.set.cluster_of, tris, s.set.cluster_count, row.clusters_per_pass});
+  }
+  std::optional<render::Renderer> made;
   try {
-    const cpca::CompressedSet set = cpca::read_compressed(compressed);
-    const meshes::Mesh mesh = meshes::load_mesh(mesh_path.empty() ? set.mesh_path : mesh_path);
-    std::optional<prt::TransferSet> transfer;
-    if (!transfer_path.empty()) transfer = prt::read_transfer(transfer_path);
-    const probes::Probe probe = load_bench_probe(probe_path);
-    const prt::ShLighting lighting = prt::project(probe, set.order);
-    const meshes::Bounds b = meshes::bounds(mesh);
-    double radius = 0;
-    for (const auto& p : mesh.positions) radius = std::max(radius, double((p - b.center()).norm()));
-    const render::Camera camera =
-        render::frame_sphere(b.center().cast<double>(), radius, width, height);
-    if (gl.backend == render::GlBackend::kEgl && gl.device >= 0 &&
-        std::size_t(gl.device) >= render::list_egl_devices().size()) {
-      std::fprintf(stderr, "render_bench: --gl-device %d: EGL lists %zu devices\n", gl.device,
-                   render::list_egl_devices().size());
-      return 2;
+    made.emplace(s.mesh, &s.set, s.transfer ? &*s.transfer : nullptr, &s.probe, o);
+  } catch (const std::invalid_argument& e) {  // this context cannot run the row
+    std::printf("%-28s (skipped: %s)\n", name.c_str(), e.what());
+    return std::nullopt;
+  }
+  render::Renderer& r = *made;
+  // Process CPU time over every thread (llvmpipe's included) per frame: the work, which
+  // a shared machine's load inflates far less than the wall clock.
+  r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());  // compiles outside the count
+  const double cpu0 = process_cpu_ms();
+  const render::TimingSummary t =
+      render::measure(r, s.camera, s.lighting, Eigen::Matrix3d::Identity(),
+                      Eigen::Vector3d::UnitY(), 1.0, a.frames, 3);
+  const double proc_ms = (process_cpu_ms() - cpu0) / (a.frames + 3);
+  r.set_count_work(true);
+  r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
+  std::printf("%-28s %6d %8.3f %7.2f %8.2f %7.2f %7.2f %6.2f %6.2f %8.2f", name.c_str(),
+              r.stats().passes, r.stats().average_overdraw, t.fps, t.frame_ms_median,
+              t.cpu_ms_median, t.gl_ms_median, t.frame_ms_median / floors.ms,
+              t.frame_ms_median / floors.background_ms, proc_ms);
+  std::vector<render::PassWork> mesh_work = r.stats().pass_work;  // VS/ref without the quad
+  std::erase_if(mesh_work, [](const render::PassWork& p) { return p.label == "background"; });
+  print_work(mesh_work);
+  details.emplace_back(name, r.stats().pass_work);
+  std::fflush(stdout);
+  return Sample{r.stats().average_overdraw, t.frame_ms_median, proc_ms};
+}
+
+// Per draw, so a path's waste can be traced to the draw that has it; multipass shading
+// passes as one line (their sum, and the worst pass).
+void print_details(const PassDetails& details) {
+  std::printf("\nper draw: VS invocations / referenced vertices (primitives, FS invocations)\n");
+  for (const auto& [name, work] : details) {
+    std::printf("%s:\n", name.c_str());
+    std::vector<render::PassWork> shade;
+    double worst = 0;
+    for (const render::PassWork& p : work) {
+      const double ratio =
+          p.referenced_vertices ? double(p.vs_invocations) / double(p.referenced_vertices) : 0.0;
+      if (p.label.starts_with("shade ")) {
+        shade.push_back(p);
+        worst = std::max(worst, ratio);
+        continue;
+      }
+      std::printf("  %-12s %8llu / %7llu = %6.3f  (%llu prims, %llu FS)\n", p.label.c_str(),
+                  (unsigned long long)p.vs_invocations, (unsigned long long)p.referenced_vertices,
+                  ratio, (unsigned long long)p.primitives, (unsigned long long)p.fs_invocations);
     }
-    render::GlContext context(gl);
-    const render::GlInfo gl_info = context.info();
-    std::printf("render_bench: %s, %s, %s, %s accumulation\n", context.description().c_str(),
-                gl_info.renderer.c_str(), gl_info.version.c_str(),
-                render::accumulation_name(render::resolve_accumulation(accumulation)));
-    std::printf(
-        "render_bench: %s, %zu vertices, %zu triangles, %d clusters x %d PCs, order %d, "
-        "%d x %d, %d frames (median)\n",
-        compressed.c_str(), mesh.vertex_count(), mesh.triangle_count(), set.cluster_count,
-        set.component_count, set.order, width, height, frames);
-    // Every floor draws into the renderer's framebuffer format; "+ background" also runs the
-    // renderer's probe background pass, so a path's ratio to it compares like with like.
-    std::vector<render::PassWork> floor_work, floor_bg_work;
-    const double floor_ms =
-        render::floor_frame_ms(mesh, camera, {true, true, frames, 3, nullptr, &floor_work});
-    const double floor_bg =
-        render::floor_frame_ms(mesh, camera, {true, true, frames, 3, &probe, &floor_bg_work});
-    const double floor_plain = render::floor_frame_ms(mesh, camera, {false, false, frames, 3});
-    // The floors' process CPU per frame: a run of 5F frames less a run of F, so the
-    // harness's setup (index order, compile, probe upload) and any first-frame cost cancel.
-    auto floor_cpu_ms = [&](const probes::Probe* bg) {
-      auto run_cpu = [&](int n) {
-        const double c0 = process_cpu_ms();
-        render::floor_frame_ms(mesh, camera, {true, true, n, 1, bg});
-        return process_cpu_ms() - c0;
-      };
-      const double few = run_cpu(frames);
-      return (run_cpu(5 * frames) - few) / (4 * frames);
-    };
-    const double floor_cpu = floor_cpu_ms(nullptr), floor_bg_cpu = floor_cpu_ms(&probe);
-    std::printf("%-28s %6s %8s %7s %8s %7s %7s %6s %6s %8s %9s %9s %6s %10s\n", "configuration",
-                "passes", "overdraw", "FPS", "frame ms", "cpu ms", "gl ms", "/floor", "/fl+bg",
-                "proc cpu", "VS inv", "ref verts", "VS/ref", "FS inv");
-    auto print_work = [](const std::vector<render::PassWork>& work) {
-      const render::WorkTotals w = render::work_totals(work);
-      std::printf(" %9llu %9llu %6.3f %10llu\n", (unsigned long long)w.vs_invocations,
-                  (unsigned long long)w.referenced_vertices, w.vs_per_referenced_vertex,
-                  (unsigned long long)w.fs_invocations);
-    };
-    auto mesh_only = [](std::vector<render::PassWork> work) {  // VS/ref without the quad
-      std::erase_if(work, [](const render::PassWork& p) { return p.label == "background"; });
-      return work;
-    };
-    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f %8.2f",
-                "floor (trivial, cull+order)", 1, 1.0, 1000.0 / floor_ms, floor_ms, "-", "-", 1.0,
-                floor_ms / floor_bg, floor_cpu);
-    print_work(floor_work);
-    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f %8.2f", "floor + background", 1,
-                1.0, 1000.0 / floor_bg, floor_bg, "-", "-", floor_bg / floor_ms, 1.0, floor_bg_cpu);
-    print_work(floor_bg_work);
-    std::printf("%-28s %6d %8.3f %7.2f %8.2f %7s %7s %6.2f %6.2f\n", "floor (trivial, plain)", 1,
-                1.0, 1000.0 / floor_plain, floor_plain, "-", "-", floor_plain / floor_ms,
-                floor_plain / floor_bg);
-    struct Row {
-      const char* name;
-      render::Mode mode;
-      int clusters_per_pass;
-      const char* strategy = nullptr;  // cpca::group_clusters name; null: cluster order
-    };
-    // The thesis configuration is the ILS row: 3 clusters per pass grouped by ILS.
-    const Row rows[] = {{"multipass, context budget", render::Mode::kMultipass, 0},
-                        {"multipass, 16 clusters/pass", render::Mode::kMultipass, 16},
-                        {"multipass, 3 clusters/pass", render::Mode::kMultipass, 3},
-                        {"multipass, 3/pass, ILS", render::Mode::kMultipass, 3, "ils"},
-                        {"decoupled, 3 clusters/pass", render::Mode::kDecoupled, 3},
-                        {"single-pass (SSBO)", render::Mode::kSinglepass, 0},
-                        {"uncompressed", render::Mode::kUncompressed, 0},
-                        {"cpu-shaded", render::Mode::kCpu, 0}};
-    std::vector<std::pair<std::string, std::vector<render::PassWork>>> details;
-    std::vector<Sample> multipass_3;  // 3 clusters per pass: order, then ILS
-    Sample thesis, floor{1.0, floor_ms, floor_cpu};
-    // Multipass twice: shading by feedback (the default) and in the triangle draws
-    // (", in-draw"), so the effect is a ratio within this run.
-    for (const Row& row : rows)
-      for (bool feedback : {false, true}) {
-        if (!feedback && row.mode != render::Mode::kMultipass) continue;
-        if (row.mode == render::Mode::kUncompressed && !transfer) {
-          std::printf("%-28s (skipped: pass --transfer)\n", row.name);
-          continue;
-        }
-        const std::string name = std::string(row.name) + (feedback ? "" : ", in-draw");
-        render::RendererOptions o;
-        o.accumulation = accumulation;
-        o.multipass_feedback = feedback;
-        o.mode = row.mode;
-        o.clusters_per_pass = row.clusters_per_pass;
-        if (row.strategy) {
-          std::vector<cpca::TriangleIndices> tris(mesh.triangles.begin(), mesh.triangles.end());
-          o.groups = cpca::group_clusters(
-              row.strategy, {set.cluster_of, tris, set.cluster_count, row.clusters_per_pass});
-        }
-        std::optional<render::Renderer> made;
-        try {
-          made.emplace(mesh, &set, transfer ? &*transfer : nullptr, &probe, o);
-        } catch (const std::invalid_argument& e) {  // this context cannot run the row
-          std::printf("%-28s (skipped: %s)\n", name.c_str(), e.what());
-          continue;
-        }
-        render::Renderer& r = *made;
-        // Process CPU time over every thread (llvmpipe's included) per frame: the work, which
-        // a shared machine's load inflates far less than the wall clock.
-        r.render(camera, lighting, Eigen::Matrix3d::Identity());  // compiles outside the count
-        const double cpu0 = process_cpu_ms();
-        const render::TimingSummary t =
-            render::measure(r, camera, lighting, Eigen::Matrix3d::Identity(),
-                            Eigen::Vector3d::UnitY(), 1.0, frames, 3);
-        const double proc_ms = (process_cpu_ms() - cpu0) / (frames + 3);
-        r.set_count_work(true);
-        r.render(camera, lighting, Eigen::Matrix3d::Identity());
-        std::printf("%-28s %6d %8.3f %7.2f %8.2f %7.2f %7.2f %6.2f %6.2f %8.2f", name.c_str(),
-                    r.stats().passes, r.stats().average_overdraw, t.fps, t.frame_ms_median,
-                    t.cpu_ms_median, t.gl_ms_median, t.frame_ms_median / floor_ms,
-                    t.frame_ms_median / floor_bg, proc_ms);
-        print_work(mesh_only(r.stats().pass_work));
-        details.emplace_back(name, r.stats().pass_work);
-        if (feedback && row.mode == render::Mode::kMultipass && row.clusters_per_pass == 3)
-          multipass_3.push_back({r.stats().average_overdraw, t.frame_ms_median, proc_ms});
-        if (feedback && row.strategy)
-          thesis = {r.stats().average_overdraw, t.frame_ms_median, proc_ms};
-        std::fflush(stdout);
-      }
-    print_targets(multipass_3, thesis, floor, floor_bg);
-    // Per draw, so a path's waste can be traced to the draw that has it; multipass shading
-    // passes as one line (their sum, and the worst pass).
-    std::printf("\nper draw: VS invocations / referenced vertices (primitives, FS invocations)\n");
-    for (const auto& [name, work] : details) {
-      std::printf("%s:\n", name.c_str());
-      std::vector<render::PassWork> shade;
-      double worst = 0;
-      for (const render::PassWork& p : work) {
-        const double ratio =
-            p.referenced_vertices ? double(p.vs_invocations) / double(p.referenced_vertices) : 0.0;
-        if (p.label.starts_with("shade ")) {
-          shade.push_back(p);
-          worst = std::max(worst, ratio);
-          continue;
-        }
-        std::printf("  %-12s %8llu / %7llu = %6.3f  (%llu prims, %llu FS)\n", p.label.c_str(),
-                    (unsigned long long)p.vs_invocations, (unsigned long long)p.referenced_vertices,
-                    ratio, (unsigned long long)p.primitives, (unsigned long long)p.fs_invocations);
-      }
-      if (!shade.empty()) {
-        const render::WorkTotals t = render::work_totals(shade);
-        std::printf(
-            "  %zu passes   %8llu / %7llu = %6.3f  (%llu prims, %llu FS; worst pass %.3f)\n",
-            shade.size(), (unsigned long long)t.vs_invocations,
-            (unsigned long long)t.referenced_vertices, t.vs_per_referenced_vertex,
-            (unsigned long long)t.primitives, (unsigned long long)t.fs_invocations, worst);
-      }
+    if (!shade.empty()) {
+      const render::WorkTotals t = render::work_totals(shade);
+      std::printf("  %zu passes   %8llu / %7llu = %6.3f  (%llu prims, %llu FS; worst pass %.3f)\n",
+                  shade.size(), (unsigned long long)t.vs_invocations,
+                  (unsigned long long)t.referenced_vertices, t.vs_per_referenced_vertex,
+                  (unsigned long long)t.primitives, (unsigned long long)t.fs_invocations, worst);
     }
+  }
+}
+
+void run(const Args& a) {
+  const Scene s = load_scene(a);
+  if (a.gl.backend == render::GlBackend::kEgl && a.gl.device >= 0 &&
+      std::size_t(a.gl.device) >= render::list_egl_devices().size())
+    throw UsageError("--gl-device " + std::to_string(a.gl.device) + ": EGL lists " +
+                     std::to_string(render::list_egl_devices().size()) + " devices");
+  render::GlContext context(a.gl);
+  const render::GlInfo gl_info = context.info();
+  std::printf("render_bench: %s, %s, %s, %s accumulation\n", context.description().c_str(),
+              gl_info.renderer.c_str(), gl_info.version.c_str(),
+              render::kAccumulationNames.name(render::resolve_accumulation(a.accumulation)));
+  std::printf(
+      "render_bench: %s, %zu vertices, %zu triangles, %d clusters x %d PCs, order %d, "
+      "%d x %d, %d frames (median)\n",
+      a.compressed.c_str(), s.mesh.vertex_count(), s.mesh.triangle_count(), s.set.cluster_count,
+      s.set.component_count, s.set.order, a.width, a.height, a.frames);
+  const Floors floors = measure_floors(s, a.frames);
+  PassDetails details;
+  std::vector<Sample> multipass_3;  // 3 clusters per pass: order, then ILS
+  Sample thesis;
+  // Multipass twice: shading by feedback (the default) and in the triangle draws
+  // (", in-draw"), so the effect is a ratio within this run.
+  for (const Row& row : kRows)
+    for (bool feedback : {false, true}) {
+      if (!feedback && row.mode != render::Mode::kMultipass) continue;
+      if (row.mode == render::Mode::kUncompressed && !s.transfer) {
+        std::printf("%-28s (skipped: pass --transfer)\n", row.name);
+        continue;
+      }
+      const std::optional<Sample> sample = run_row(s, a, floors, row, feedback, details);
+      if (!sample) continue;
+      if (feedback && row.mode == render::Mode::kMultipass && row.clusters_per_pass == 3)
+        multipass_3.push_back(*sample);
+      if (feedback && row.strategy) thesis = *sample;
+    }
+  print_targets(multipass_3, thesis, {1.0, floors.ms, floors.cpu_ms}, floors.background_ms);
+  print_details(details);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    run(parse_args(argc, argv));
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "render_bench: %s\n", e.what());
+    return 2;
   } catch (const std::invalid_argument& e) {  // a flag's value the benchmark cannot use
     std::fprintf(stderr, "render_bench: %s\n", e.what());
     return 2;

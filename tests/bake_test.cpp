@@ -464,7 +464,8 @@ void expect_glossy_bounce_matches_nested_mc(const prt::Material& material) {
     // 4 sigma of the nested estimate (1.4-2.3% of the value), plus 1% for the bake's linear
     // interpolation of hit radiance across the 8 x 8 wall grid. Measured: 0.9-2.1 sigma.
     EXPECT_NEAR(value, brute, 4 * sigma + 0.01 * std::abs(brute))
-        << prt::material_name(material.kind) << " view " << view.transpose() << " sigma " << sigma;
+        << prt::kMaterialNames.name(material.kind) << " view " << view.transpose() << " sigma "
+        << sigma;
     EXPECT_GT(std::abs(brute), 10 * sigma);  // the bounce is a measurable signal here
   }
 }

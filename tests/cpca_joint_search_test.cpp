@@ -83,7 +83,8 @@ TEST(JointSearch, ObjectiveNeverRisesAndMatchesARecount) {
   const cpca::DataMatrix x = smooth_data(g, 5);
   for (const auto method : {cpca::ClusterMethod::kJoint, cpca::ClusterMethod::kPatchJoint})
     for (double lambda : {0.05, 0.5, 5.0}) {
-      SCOPED_TRACE(std::string(cpca::cluster_method_name(method)) + " " + std::to_string(lambda));
+      SCOPED_TRACE(std::string(cpca::kClusterMethodNames.name(method)) + " " +
+                   std::to_string(lambda));
       cpca::JointSearchResult search;
       const cpca::CompressedSet set =
           cpca::compress_joint(x, options(method, lambda), g, nullptr, &search);

@@ -328,12 +328,12 @@ TEST(MaterialParams, ValidateNamesTheFlagAndTheRange) {
 TEST(MaterialParams, NamesRoundTrip) {
   for (prt::MaterialKind kind :
        {prt::MaterialKind::kLambert, prt::MaterialKind::kPhong, prt::MaterialKind::kCookTorrance}) {
-    EXPECT_EQ(prt::parse_material(prt::material_name(kind)), kind);
+    EXPECT_EQ(prt::kMaterialNames.parse(prt::kMaterialNames.name(kind)), kind);
   }
-  EXPECT_STREQ(prt::material_name(prt::MaterialKind::kCookTorrance), "cook-torrance");
+  EXPECT_STREQ(prt::kMaterialNames.name(prt::MaterialKind::kCookTorrance), "cook-torrance");
   for (const char* bad : {"glass", "Phong", ""}) {
     try {
-      prt::parse_material(bad);
+      prt::kMaterialNames.parse(bad);
       ADD_FAILURE() << "'" << bad << "' was accepted";
     } catch (const std::invalid_argument& error) {
       const std::string message = error.what();
@@ -413,7 +413,7 @@ TEST(BrdfEval, Reciprocity) {
       const double forward = prt::brdf_eval(m, 0, v, s), backward = prt::brdf_eval(m, 0, s, v);
       ASSERT_TRUE(std::isfinite(forward));
       ASSERT_NEAR(forward, backward, 1e-12 * std::max(1.0, std::abs(forward)))
-          << prt::material_name(m.kind) << " v=" << v.transpose() << " s=" << s.transpose();
+          << prt::kMaterialNames.name(m.kind) << " v=" << v.transpose() << " s=" << s.transpose();
     }
   }
 }
@@ -457,7 +457,7 @@ TEST(BrdfEval, DirectionalAlbedoAtMostOne) {
   for (const prt::Material& m : {phong(8.f, 0.5f, 0.5f), phong(1.f, 0.f, 1.f),
                                  make_material(prt::MaterialKind::kLambert, 1.f, 0.f)})
     EXPECT_NEAR(library_albedo(m, Eigen::Vector3d::UnitZ(), inner), 1.0, 1e-6)
-        << prt::material_name(m.kind) << " e=" << m.exponent;
+        << prt::kMaterialNames.name(m.kind) << " e=" << m.exponent;
 }
 
 // --- brdf_matrix: grid, reference quadrature, Lambert closed form ---------------------------
@@ -526,7 +526,7 @@ TEST(BrdfMatrix, MatchesNaiveQuadratureOfBrdfEval) {
     }
     const Eigen::MatrixXd b = prt::brdf_matrix(m, order, channel, q, prt::ViewFit::kHemisphere);
     EXPECT_LT((b - reference).cwiseAbs().maxCoeff(), 1e-12 * reference.cwiseAbs().maxCoeff())
-        << prt::material_name(m.kind) << " e=" << m.exponent << " m=" << m.roughness;
+        << prt::kMaterialNames.name(m.kind) << " e=" << m.exponent << " m=" << m.roughness;
   }
 }
 
@@ -562,7 +562,7 @@ TEST(LambertMatrix, NumericalMatchesClosedFormAndIsRankOne) {
         make_material(prt::MaterialKind::kLambert, float(rho), 0.f), kOrder, 0, {}, fit);
     const Eigen::MatrixXd closed = prt::lambert_brdf_matrix(double(float(rho)), kOrder, fit);
     // The default Lambert grid is exact (material.cpp), so 1e-6 is far above rounding (~1e-15).
-    EXPECT_LT((numerical - closed).cwiseAbs().maxCoeff(), 1e-6) << prt::view_fit_name(fit);
+    EXPECT_LT((numerical - closed).cwiseAbs().maxCoeff(), 1e-6) << prt::kViewFitNames.name(fit);
     EXPECT_GT(closed.cwiseAbs().maxCoeff(), 0.1);
 
     for (const Eigen::MatrixXd& b : {numerical, closed}) {
@@ -642,7 +642,7 @@ TEST(BrdfMatrix, CommutesWithRotationsAboutTheNormal) {
       const Eigen::MatrixXd d =
           prt::ShRotation(kOrder, prt::axis_angle(Eigen::Vector3d::UnitZ(), alpha)).dense();
       EXPECT_LT((b * d - d * b).cwiseAbs().maxCoeff(), 1e-9 * scale)
-          << prt::material_name(m.kind) << " alpha " << alpha;
+          << prt::kMaterialNames.name(m.kind) << " alpha " << alpha;
     }
     double coupled = 0.0;  // the selection rule must not hold vacuously
     for (int i = 0; i < kN; ++i) {
@@ -657,7 +657,7 @@ TEST(BrdfMatrix, CommutesWithRotationsAboutTheNormal) {
         }
       }
     }
-    EXPECT_GT(coupled, 0.01 * scale) << prt::material_name(m.kind);
+    EXPECT_GT(coupled, 0.01 * scale) << prt::kMaterialNames.name(m.kind);
   }
 }
 
@@ -684,13 +684,14 @@ TEST(BrdfMatrix, ExitRadianceMatchesBruteForce) {
         prt::brdf_matrix(m, kOrder, 0, {}, prt::ViewFit::kHemisphere) * lighting;
     const auto start = std::chrono::steady_clock::now();
     const Eigen::MatrixXd brute = brute_force_projection(m, lighting, 20, {48, 192});
-    std::cout << prt::material_name(m.kind) << " brute force: " << seconds_since(start) << " s\n";
+    std::cout << prt::kMaterialNames.name(m.kind) << " brute force: " << seconds_since(start)
+              << " s\n";
     for (int c = 0; c < 2; ++c) {
       const double scale = prt_side.col(c).cwiseAbs().maxCoeff();
       const double error = (prt_side.col(c) - brute.col(c)).cwiseAbs().maxCoeff();
       std::cout << "  lighting part " << c << ": max |B l| " << scale << ", max error " << error
                 << " (" << error / scale << " relative)\n";
-      EXPECT_LT(error, 5e-4 * scale) << prt::material_name(m.kind) << " part " << c;
+      EXPECT_LT(error, 5e-4 * scale) << prt::kMaterialNames.name(m.kind) << " part " << c;
     }
   }
 }
@@ -710,9 +711,11 @@ TEST(BrdfMatrix, DefaultGridHasConverged) {
           m, kOrder, 0, {2 * q.view_theta, 2 * q.view_phi, 2 * q.light_theta, 2 * q.light_phi},
           fit);
       const double difference = (coarse - fine).norm() / fine.norm();
-      std::cout << prt::material_name(m.kind) << " e=" << m.exponent << " m=" << m.roughness << " "
-                << prt::view_fit_name(fit) << ": default vs 2x grid " << difference << "\n";
-      EXPECT_LT(difference, bound) << prt::material_name(m.kind) << " " << prt::view_fit_name(fit);
+      std::cout << prt::kMaterialNames.name(m.kind) << " e=" << m.exponent << " m=" << m.roughness
+                << " " << prt::kViewFitNames.name(fit) << ": default vs 2x grid " << difference
+                << "\n";
+      EXPECT_LT(difference, bound)
+          << prt::kMaterialNames.name(m.kind) << " " << prt::kViewFitNames.name(fit);
     }
   }
 }

@@ -118,8 +118,8 @@ Eigen::Vector3d view_at(const meshes::Mesh& mesh, std::size_t p, double degrees,
 TEST(ViewFit, NamesRoundTrip) {
   for (prt::ViewFit f : {prt::ViewFit::kHemisphere, prt::ViewFit::kEven,
                          prt::ViewFit::kLeastSquares, prt::ViewFit::kHemisphericalHarmonics})
-    EXPECT_EQ(prt::parse_view_fit(prt::view_fit_name(f)), f);
-  EXPECT_THROW(prt::parse_view_fit("bogus"), std::invalid_argument);
+    EXPECT_EQ(prt::kViewFitNames.parse(prt::kViewFitNames.name(f)), f);
+  EXPECT_THROW(prt::kViewFitNames.parse("bogus"), std::invalid_argument);
   EXPECT_FALSE(prt::view_fit_renderable(prt::ViewFit::kHemisphericalHarmonics));
   EXPECT_TRUE(prt::view_fit_renderable(prt::kDefaultViewFit));
 }
@@ -243,8 +243,9 @@ TEST(Masking, SmithSatisfiesTheProjectedAreaIdentity) {
           << "m " << roughness << " theta " << theta_deg;
     }
   }
-  EXPECT_EQ(prt::parse_masking(prt::masking_name(prt::Masking::kVGroove)), prt::Masking::kVGroove);
-  EXPECT_THROW(prt::parse_masking("none"), std::invalid_argument);
+  EXPECT_EQ(prt::kMaskingNames.parse(prt::kMaskingNames.name(prt::Masking::kVGroove)),
+            prt::Masking::kVGroove);
+  EXPECT_THROW(prt::kMaskingNames.parse("none"), std::invalid_argument);
 }
 
 TEST(DirectionalAlbedo, ClosedForms) {
@@ -294,11 +295,11 @@ TEST(GlossyFidelity, WhiteSkyMatchesDirectionalAlbedo) {
         const double x = glossy_radiance(t, sphere, 0, white, w)[0];
         worst = std::max(worst, std::abs(x - exact) / exact);
       }
-      std::cout << prt::material_name(c.material.kind) << " "
-                << prt::masking_name(c.material.masking) << " " << prt::view_fit_name(fit)
-                << ": worst white-sky error " << worst << "\n";
+      std::cout << prt::kMaterialNames.name(c.material.kind) << " "
+                << prt::kMaskingNames.name(c.material.masking) << " "
+                << prt::kViewFitNames.name(fit) << ": worst white-sky error " << worst << "\n";
       if (fit == prt::kDefaultViewFit) {
-        EXPECT_LT(worst, c.bound) << prt::material_name(c.material.kind);
+        EXPECT_LT(worst, c.bound) << prt::kMaterialNames.name(c.material.kind);
       } else if (c.material.kind == prt::MaterialKind::kLambert) {
         EXPECT_GT(worst, 0.1);
       }

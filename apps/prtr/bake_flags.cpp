@@ -3,7 +3,6 @@
 #include "commands.h"
 #include "flag_checks.h"
 
-#include <sstream>
 #include <vector>
 
 namespace prtr_app {
@@ -11,18 +10,9 @@ namespace {
 
 // "0.5" (grey) or "0.5,0.4,0.3".
 Eigen::Vector3f parse_albedo(const std::string& text) {
-  std::vector<float> values;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      values.push_back(std::stof(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError("--albedo: '" + text + "' is not a number or R,G,B triple");
-    }
-  }
+  const auto parsed = parse_number_list(text);
+  if (!parsed) throw UsageError("--albedo: '" + text + "' is not a number or R,G,B triple");
+  const std::vector<float> values(parsed->begin(), parsed->end());
   if (values.size() == 1) return Eigen::Vector3f::Constant(values[0]);
   if (values.size() == 3) return {values[0], values[1], values[2]};
   throw UsageError("--albedo takes one value (grey) or three (R,G,B), got '" + text + "'");
@@ -35,61 +25,48 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
   cmd->add_option("--kind", f.kind, "diffuse: transfer vectors; glossy: transfer matrices")
       ->check(CLI::IsMember({"diffuse", "glossy"}))
       ->capture_default_str();
-  cmd->add_option("--order", f.bake.order, "SH order N (N^2 coefficients)")
-      ->check(integer_in(1, 10))
-      ->capture_default_str();
-  cmd->add_option("--samples", f.bake.samples, "Hemisphere directions per vertex")
-      ->check(integer_in(1, 65536))
-      ->capture_default_str();
-  cmd->add_option("--bounces", f.bake.bounces, "Interreflection passes (0: shadows only)")
-      ->check(integer_in(0, 16))
-      ->capture_default_str();
-  cmd->add_option("--seed", f.bake.seed, "Seed of the direction set")
-      ->check(unsigned_integer())
-      ->capture_default_str();
-  cmd->add_option("--material", f.material, "Reflectance model")
-      ->check(CLI::IsMember({"lambert", "phong", "cook-torrance"}))
-      ->capture_default_str();
+  add_checked_option(cmd, "--order", f.bake.order, "SH order N (N^2 coefficients)",
+                     integer_in(1, 10));
+  add_checked_option(cmd, "--samples", f.bake.samples, "Hemisphere directions per vertex",
+                     integer_in(1, 65536));
+  add_checked_option(cmd, "--bounces", f.bake.bounces, "Interreflection passes (0: shadows only)",
+                     integer_in(0, 16));
+  add_checked_option(cmd, "--seed", f.bake.seed, "Seed of the direction set", unsigned_integer());
+  add_checked_option(cmd, "--material", f.material, "Reflectance model",
+                     CLI::IsMember({"lambert", "phong", "cook-torrance"}));
   cmd->add_option("--albedo", f.albedo, "Diffuse albedo: one value (grey) or R,G,B")
       ->capture_default_str();
-  cmd->add_option("--specular", f.bake.material.specular,
-                  "Specular reflectance (phong, cook-torrance)")
-      ->check(number_in(0, 1))
-      ->capture_default_str();
-  cmd->add_option("--exponent", f.bake.material.exponent, "Phong exponent")
-      ->check(number_in(0, 10000))
-      ->capture_default_str();
+  add_checked_option(cmd, "--specular", f.bake.material.specular,
+                     "Specular reflectance (phong, cook-torrance)", number_in(0, 1));
+  add_checked_option(cmd, "--exponent", f.bake.material.exponent, "Phong exponent",
+                     number_in(0, 10000));
   // (0, 1]: number_in takes the closed range; Material::validate refuses 0 by name.
-  cmd->add_option("--roughness", f.bake.material.roughness, "Cook-Torrance Beckmann roughness")
-      ->check(number_in(0, 1))
-      ->capture_default_str();
-  cmd->add_option("--f0", f.bake.material.f0,
-                  "Cook-Torrance Fresnel reflectance at normal incidence")
-      ->check(number_in(0, 1))
-      ->capture_default_str();
-  cmd->add_option("--masking", f.masking,
-                  "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the "
-                  "thesis's)")
-      ->check(CLI::IsMember({"smith", "v-groove"}))
-      ->capture_default_str();
+  add_checked_option(cmd, "--roughness", f.bake.material.roughness,
+                     "Cook-Torrance Beckmann roughness", number_in(0, 1));
+  add_checked_option(cmd, "--f0", f.bake.material.f0,
+                     "Cook-Torrance Fresnel reflectance at normal incidence", number_in(0, 1));
+  add_checked_option(
+      cmd, "--masking", f.masking,
+      "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the thesis's)",
+      CLI::IsMember({"smith", "v-groove"}));
   cmd->add_option("--view-fit", f.view_fit,
                   "Glossy: how the view side fits exit radiance; hemisphere is the thesis's "
                   "projection (docs/ARCHITECTURE.md, \"The view side\")")
       ->check(CLI::IsMember({"least-squares", "even", "hemisphere"}))
       ->capture_default_str();
-  cmd->add_option("--ray-offset", f.bake.ray_offset,
-                  "Rays start a tenth of this x the bbox diagonal into the face they leave through")
-      ->check(number_in(0, 0.01))
-      ->capture_default_str();
+  add_checked_option(
+      cmd, "--ray-offset", f.bake.ray_offset,
+      "Rays start a tenth of this x the bbox diagonal into the face they leave through",
+      number_in(0, 0.01));
 }
 
 prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
   prt::BakeOptions bake = f.bake;
   bake.kind = f.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;
-  bake.material.kind = prt::parse_material(f.material);
+  bake.material.kind = prt::kMaterialNames.parse(f.material);
   bake.material.albedo = parse_albedo(f.albedo);
-  bake.material.masking = prt::parse_masking(f.masking);
-  bake.view_fit = prt::parse_view_fit(f.view_fit);
+  bake.material.masking = prt::kMaskingNames.parse(f.masking);
+  bake.view_fit = prt::kViewFitNames.parse(f.view_fit);
   // A flag the chosen material never reads is a mistake worth reporting.
   const auto kind = bake.material.kind;
   auto unused = [&](const char* flag, bool used) {

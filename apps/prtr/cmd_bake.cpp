@@ -137,7 +137,7 @@ void print_summary(const std::string& mesh_path, const std::string& output,
   const double rays = double(stats.rays_shadow + stats.rays_bounce);
   std::printf("baked       %s -> %s\n", mesh_path.c_str(), output.c_str());
   std::printf("transfer    %s, order %d, %d channel(s), %zu vertices, %s\n",
-              prt::transfer_kind_name(set.kind), set.order, set.channels, mesh.vertex_count(),
+              prt::kTransferKindNames.name(set.kind), set.order, set.channels, mesh.vertex_count(),
               format_bytes(set.vertex_count * set.floats_per_vertex() * sizeof(float)).c_str());
   std::printf("time        %.2f s total: %.2f s shadow, %.2f s bounces, %.2f s BRDF matrix\n",
               stats.seconds_total, stats.seconds_shadow, stats.seconds_bounces, stats.seconds_brdf);

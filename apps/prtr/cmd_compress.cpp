@@ -65,8 +65,8 @@ void print_json(const cpca::CompressedSet& set, const cpca::CompressReport& repo
   const cpca::TriangleSpan& s = report.span;
   const Json line = {{"clusters", set.cluster_count},
                      {"pcs", set.component_count},
-                     {"method", cpca::cluster_method_name(set.method)},
-                     {"pca", cpca::pca_solver_name(set.solver)},
+                     {"method", cpca::kClusterMethodNames.name(set.method)},
+                     {"pca", cpca::kPcaSolverNames.name(set.solver)},
                      {"alpha", set.alpha},
                      {"overdraw_reduction", set.overdraw_reduction},
                      {"lbg_iterations", report.lbg_iterations},
@@ -95,8 +95,8 @@ void print_text(const Options& o, const cpca::CompressedSet& set,
   const cpca::TriangleSpan& s = report.span;
   std::printf("compressed %s -> %s\n", o.transfer.c_str(), o.output.c_str());
   std::printf("  clusters %d x %d PCs, %s, PCA by %s, alpha %g%s\n", set.cluster_count,
-              set.component_count, cpca::cluster_method_name(set.method),
-              cpca::pca_solver_name(set.solver), set.alpha,
+              set.component_count, cpca::kClusterMethodNames.name(set.method),
+              cpca::kPcaSolverNames.name(set.solver), set.alpha,
               set.overdraw_reduction ? ", overdraw reduction" : "");
   std::printf("  LBG        %d iterations, %d null clusters split, %.2f s\n", report.lbg_iterations,
               report.splits, report.lbg_seconds);

@@ -62,17 +62,18 @@ void describe_transfer(const std::string& path, const std::string& mesh, bool ve
   std::printf("file        %s (%s)\n", path.c_str(),
               format_bytes(std::filesystem::file_size(path)).c_str());
   std::printf("transfer    %s, order %d (%d coefficients), %d channel(s)\n",
-              prt::transfer_kind_name(set.kind), set.order, set.coefficient_count(), set.channels);
+              prt::kTransferKindNames.name(set.kind), set.order, set.coefficient_count(),
+              set.channels);
   std::printf("vertices    %llu\n", static_cast<unsigned long long>(set.vertex_count));
   std::printf("bake        %d samples, %d bounce(s), seed %llu\n", set.samples, set.bounces,
               static_cast<unsigned long long>(set.seed));
   std::printf(
       "material    %s, albedo (%g, %g, %g), specular %g, exponent %g, roughness %g, "
       "f0 %g, masking %s\n",
-      prt::material_name(m.kind), m.albedo.x(), m.albedo.y(), m.albedo.z(), m.specular, m.exponent,
-      m.roughness, m.f0, prt::masking_name(m.masking));
+      prt::kMaterialNames.name(m.kind), m.albedo.x(), m.albedo.y(), m.albedo.z(), m.specular,
+      m.exponent, m.roughness, m.f0, prt::kMaskingNames.name(m.masking));
   if (set.kind == prt::TransferKind::kGlossy)
-    std::printf("view fit    %s\n", prt::view_fit_name(set.view_fit));
+    std::printf("view fit    %s\n", prt::kViewFitNames.name(set.view_fit));
   std::printf("mesh hash   %016llx\n", static_cast<unsigned long long>(set.mesh_hash));
   if (verify) std::printf("payload     checksum and values verified\n");
   if (!mesh.empty()) {
@@ -99,8 +100,8 @@ void describe_compressed(const std::string& path, const std::string& mesh,
   std::printf("vertices    %llu\n", u(set.vertex_count));
   std::printf("clusters    %d, %d PCs each\n", set.cluster_count, set.component_count);
   std::printf("clustering  %s, PCA solver %s, alpha %g, overdraw reduction %s\n",
-              cpca::cluster_method_name(set.method), cpca::pca_solver_name(set.solver), set.alpha,
-              set.overdraw_reduction ? "on" : "off");
+              cpca::kClusterMethodNames.name(set.method), cpca::kPcaSolverNames.name(set.solver),
+              set.alpha, set.overdraw_reduction ? "on" : "off");
   std::printf("run         seed %llu, %d iteration(s)\n", u(set.seed), set.iterations);
   std::printf("mesh        %s\n", set.mesh_path.empty() ? "(not recorded)" : set.mesh_path.c_str());
   std::printf("mesh hash   %016llx\n", u(set.mesh_hash));

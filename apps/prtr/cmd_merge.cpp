@@ -32,7 +32,7 @@ Runner add_merge_command(CLI::App& app) {
     prt::merge_shards(paths, opt->output);
     const prt::TransferSet header = prt::read_transfer_header(opt->output);
     std::printf("merged      %zu shards -> %s: %s, order %d, %llu vertices\n", paths.size(),
-                opt->output.c_str(), prt::transfer_kind_name(header.kind), header.order,
+                opt->output.c_str(), prt::kTransferKindNames.name(header.kind), header.order,
                 static_cast<unsigned long long>(header.vertex_count));
   };
 }

@@ -61,14 +61,12 @@ Runner add_mesh_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "mesh", "Load a mesh and print its facts; optionally subdivide and write it");
   cmd->add_option("MESH", opt->path, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
-  cmd->add_option("--weld-tolerance", opt->weld,
-                  "Weld positions closer than this fraction of the bounding-box diagonal "
-                  "(negative: no welding)")
-      ->check(number_in(-1, 1))
-      ->capture_default_str();
-  cmd->add_option("--normals", opt->normals, "Vertex normal weighting")
-      ->check(CLI::IsMember({"angle", "area"}))
-      ->capture_default_str();
+  add_checked_option(cmd, "--weld-tolerance", opt->weld,
+                     "Weld positions closer than this fraction of the bounding-box diagonal "
+                     "(negative: no welding)",
+                     number_in(-1, 1));
+  add_checked_option(cmd, "--normals", opt->normals, "Vertex normal weighting",
+                     CLI::IsMember({"angle", "area"}));
   add_mesh_flags(cmd, opt->mesh_flags);
   cmd->add_option("--subdivide", opt->subdivide,
                   "Rounds of Loop subdivision before writing -o (each: ~4x the vertices)")

@@ -100,27 +100,18 @@ void add_flags(CLI::App* cmd, Options& o) {
                   "default: the GL context's register budget; thesis: 3 clusters per pass; or a "
                   "number of vec4 registers")
       ->capture_default_str();
-  cmd->add_option("--frames", o.frames, "Timed frames per row in every round")
-      ->check(integer_in(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--rounds", o.rounds,
-                  "Timing rounds, each visiting every row in turn for --warmup + --frames "
-                  "frames (FPS = median over all rounds, with the interquartile range)")
-      ->check(integer_in(1, 1000))
-      ->capture_default_str();
-  cmd->add_option("--warmup", o.warmup, "Untimed frames first (every round)")
-      ->check(integer_in(0, 100000))
-      ->capture_default_str();
-  cmd->add_option("--degrees-per-frame", o.degrees_per_frame,
-                  "Environment rotation per frame about +Y while timing")
-      ->check(angle_degrees())
-      ->capture_default_str();
-  cmd->add_option("--width", o.width, "Image width")
-      ->check(integer_in(1, 16384))
-      ->capture_default_str();
-  cmd->add_option("--height", o.height, "Image height")
-      ->check(integer_in(1, 16384))
-      ->capture_default_str();
+  add_checked_option(cmd, "--frames", o.frames, "Timed frames per row in every round",
+                     integer_in(1, 100000));
+  add_checked_option(cmd, "--rounds", o.rounds,
+                     "Timing rounds, each visiting every row in turn for --warmup + --frames "
+                     "frames (FPS = median over all rounds, with the interquartile range)",
+                     integer_in(1, 1000));
+  add_checked_option(cmd, "--warmup", o.warmup, "Untimed frames first (every round)",
+                     integer_in(0, 100000));
+  add_checked_option(cmd, "--degrees-per-frame", o.degrees_per_frame,
+                     "Environment rotation per frame about +Y while timing", angle_degrees());
+  add_checked_option(cmd, "--width", o.width, "Image width", integer_in(1, 16384));
+  add_checked_option(cmd, "--height", o.height, "Image height", integer_in(1, 16384));
   cmd->add_option("--out", o.out, "Directory for CSV, JSON, plot and pictures")
       ->capture_default_str();
   cmd->add_option("--plot", o.pareto_plot,
@@ -140,7 +131,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_gl_flags(cmd, o.gl);
 }
 
-OverdrawPlan make_plan(Options& o, const CLI::App* cmd) {
+OverdrawPlan make_plan(const Options& o, const CLI::App* cmd) {
   OverdrawPlan plan;
   plan.clusters = parse_clusters(o.clusters);
   plan.methods = split_list(o.rows, "--rows");
@@ -241,36 +232,36 @@ void write_outputs(const OverdrawReport& report, const OverdrawPlan& plan, const
       plots.c_str(), plotted.c_str());
 }
 
+void run(const Options& o, CLI::App* cmd) {
+  OverdrawPlan plan = make_plan(o, cmd);
+  auto bar = std::make_shared<ProgressBar>(o.quiet);
+  if (!o.quiet) {
+    plan.note = [bar](const std::string& text) {
+      bar->finish();
+      std::fprintf(stderr, "overdraw: %s\n", text.c_str());
+    };
+    plan.progress = [bar](const std::string& label, std::uint64_t step, std::uint64_t steps) {
+      bar->update(label, step, steps);
+    };
+  }
+  OverdrawReport report;
+  try {
+    report = overdraw::run_overdraw(plan);
+  } catch (const PlanError& e) {
+    throw UsageError(e.what());
+  }
+  bar->finish();
+  write_outputs(report, plan, o);
+}
+
+constexpr const char* kAbout =
+    "Overdraw benchmark (thesis tables 5.2-5.17): methods x strategies x budgets -> clustering "
+    "time, average overdraw, FPS, Average SE, image RMSE; Markdown, CSV, JSON, plot, pictures";
+
 }  // namespace
 
 Runner add_overdraw_command(CLI::App& app) {
-  auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "overdraw",
-      "Overdraw benchmark (thesis tables 5.2-5.17): methods x strategies x budgets -> clustering "
-      "time, average overdraw, FPS, Average SE, image RMSE; Markdown, CSV, JSON, plot, pictures");
-  add_flags(cmd, *opt);
-  return [opt, cmd] {
-    OverdrawPlan plan = make_plan(*opt, cmd);
-    auto bar = std::make_shared<ProgressBar>(opt->quiet);
-    if (!opt->quiet) {
-      plan.note = [bar](const std::string& text) {
-        bar->finish();
-        std::fprintf(stderr, "overdraw: %s\n", text.c_str());
-      };
-      plan.progress = [bar](const std::string& label, std::uint64_t step, std::uint64_t steps) {
-        bar->update(label, step, steps);
-      };
-    }
-    OverdrawReport report;
-    try {
-      report = overdraw::run_overdraw(plan);
-    } catch (const PlanError& e) {
-      throw UsageError(e.what());
-    }
-    bar->finish();
-    write_outputs(report, plan, *opt);
-  };
+  return add_command<Options>(app, "overdraw", kAbout, add_flags, run);
 }
 
 }  // namespace prtr_app

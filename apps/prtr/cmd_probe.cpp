@@ -66,9 +66,8 @@ Runner add_probe_command(CLI::App& app) {
                   "Environment map (EXR, HDR, ...); for six cube faces a folder holding "
                   "px nx py ny pz nz, or a name with {face} in it")
       ->required();
-  cmd->add_option("--order", opt->order, "SH order N (bands 0..N-1, N^2 coefficients)")
-      ->check(integer_in(prt::kMinOrder, prt::kMaxOrder))
-      ->capture_default_str();
+  add_checked_option(cmd, "--order", opt->order, "SH order N (bands 0..N-1, N^2 coefficients)",
+                     integer_in(prt::kMinOrder, prt::kMaxOrder));
   cmd->add_option("--layout", opt->layout,
                   "Map layout; auto: 2:1 lat-long, 1:1 angular, 4:3 / 3:4 cube cross, a folder "
                   "or {face} name six cube faces")

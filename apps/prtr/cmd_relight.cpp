@@ -89,15 +89,11 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("MESH", o.mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
-  cmd->add_option("--frames", o.frames, "Frames in the sequence")
-      ->check(integer_in(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--degrees", o.degrees, "Total environment rotation over the sequence")
-      ->check(angle_degrees())
-      ->capture_default_str();
-  cmd->add_option("--mode", o.mode, "Rendering path (render/renderer.h)")
-      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}))
-      ->capture_default_str();
+  add_checked_option(cmd, "--frames", o.frames, "Frames in the sequence", integer_in(1, 100000));
+  add_checked_option(cmd, "--degrees", o.degrees, "Total environment rotation over the sequence",
+                     angle_degrees());
+  add_checked_option(cmd, "--mode", o.mode, "Rendering path (render/renderer.h)",
+                     CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}));
   cmd->add_option("--strategy", o.strategy, "Super-cluster strategy for multipass/decoupled")
       ->capture_default_str();
   cmd->add_option("--register-budget", o.register_budget,
@@ -112,24 +108,17 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_gl_flags(cmd, o.gl);
   add_accumulation_flag(cmd, o.accumulation);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
-  cmd->add_option("--columns", o.columns, "Contact sheet columns")
-      ->check(integer_in(1, 64))
-      ->capture_default_str();
-  cmd->add_option("--thumbnail", o.thumbnail, "Contact sheet thumbnail width (pixels)")
-      ->check(integer_in(16, 4096))
-      ->capture_default_str();
-  cmd->add_option("--fps", o.fps, "Video frame rate")
-      ->check(integer_in(1, 240))
-      ->capture_default_str();
-  cmd->add_option("--gif-width", o.gif_width,
-                  "Width of the animated GIF preview in pixels (0: the frames' own size)")
-      ->check(integer_in(0, 65535))
-      ->capture_default_str();
-  cmd->add_option("--exr-pixels", o.exr_pixels,
-                  "EXR frames as half floats (PIZ, what renderers write for sequences) or "
-                  "32-bit floats (ZIP, as prtr render writes)")
-      ->check(CLI::IsMember({"half", "float"}))
-      ->capture_default_str();
+  add_checked_option(cmd, "--columns", o.columns, "Contact sheet columns", integer_in(1, 64));
+  add_checked_option(cmd, "--thumbnail", o.thumbnail, "Contact sheet thumbnail width (pixels)",
+                     integer_in(16, 4096));
+  add_checked_option(cmd, "--fps", o.fps, "Video frame rate", integer_in(1, 240));
+  add_checked_option(cmd, "--gif-width", o.gif_width,
+                     "Width of the animated GIF preview in pixels (0: the frames' own size)",
+                     integer_in(0, 65535));
+  add_checked_option(cmd, "--exr-pixels", o.exr_pixels,
+                     "EXR frames as half floats (PIZ, what renderers write for sequences) or "
+                     "32-bit floats (ZIP, as prtr render writes)",
+                     CLI::IsMember({"half", "float"}));
   cmd->add_flag("--no-video", o.no_video, "Do not encode the MP4 (the GIF is always written)");
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
 }
@@ -172,8 +161,8 @@ std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::
                                                 const probes::Probe& probe,
                                                 const render::GlContext& context) {
   render::RendererOptions ro;
-  ro.mode = render::parse_mode(o.mode);
-  ro.accumulation = render::parse_accumulation(o.accumulation);
+  ro.mode = render::kModeNames.parse(o.mode);
+  ro.accumulation = render::kAccumulationNames.parse(o.accumulation);
   ro.register_budget = o.register_budget;
   try {
     if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
@@ -314,45 +303,42 @@ void print_summary(const Options& o, const render::RenderStats& st, const render
   std::printf("contact sheet: %s\n", sheet.string().c_str());
 }
 
+void run(const Options& o, CLI::App*) {
+  const auto start = Clock::now();
+  const prt::BakeOptions bake = resolve_bake_flags(o.bake);
+  const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
+  resolve_axis(o.view);
+  resolve_background(o.view);
+  const render::GlSelection gl = gl_selection(o.gl);
+  check_sizes(bake, compress);
+  const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
+  if (std::size_t(compress.clusters) > mesh.vertex_count())
+    throw UsageError("--clusters " + std::to_string(compress.clusters) + " exceeds the " +
+                     std::to_string(mesh.vertex_count()) + " vertices of " + o.mesh);
+  const render::Camera camera = resolve_camera(o.view, mesh);
+  const probes::Probe probe = probes::load_probe(o.probe);  // fail before the long work
+  make_output_directory(o.out);
+  const cpca::CompressedSet set = cpca::read_compressed(bake_and_compress(o, mesh, bake, compress));
+  const prt::ShLighting lighting = prt::project(probe, set.order);
+  render::GlContext context(gl);
+  const auto renderer = make_renderer(o, mesh, set, probe, context);
+  Previews previews = make_previews(o, camera);
+  const FrameTimes times =
+      render_frames(o, *renderer, render::supersampled(camera, o.supersample), lighting, previews);
+  const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
+  render::write_png(sheet, tile(previews.thumbnails, o.columns), o.view.exposure);
+  const std::string video = make_animations(o, previews);
+  print_summary(o, renderer->stats(), camera, times, video, sheet, seconds_since(start));
+}
+
+constexpr const char* kAbout =
+    "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
+    "previews, a contact sheet, an animated GIF and an MP4 (ffmpeg)";
+
 }  // namespace
 
 Runner add_relight_command(CLI::App& app) {
-  auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "relight",
-      "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
-      "previews, a contact sheet, an animated GIF and an MP4 (ffmpeg)");
-  add_flags(cmd, *opt);
-
-  return [opt] {
-    const Options& o = *opt;
-    const auto start = Clock::now();
-    const prt::BakeOptions bake = resolve_bake_flags(o.bake);
-    const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
-    resolve_axis(o.view);
-    resolve_background(o.view);
-    const render::GlSelection gl = gl_selection(o.gl);
-    check_sizes(bake, compress);
-    const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
-    if (std::size_t(compress.clusters) > mesh.vertex_count())
-      throw UsageError("--clusters " + std::to_string(compress.clusters) + " exceeds the " +
-                       std::to_string(mesh.vertex_count()) + " vertices of " + o.mesh);
-    const render::Camera camera = resolve_camera(o.view, mesh);
-    const probes::Probe probe = probes::load_probe(o.probe);  // fail before the long work
-    make_output_directory(o.out);
-    const cpca::CompressedSet set =
-        cpca::read_compressed(bake_and_compress(o, mesh, bake, compress));
-    const prt::ShLighting lighting = prt::project(probe, set.order);
-    render::GlContext context(gl);
-    const auto renderer = make_renderer(o, mesh, set, probe, context);
-    Previews previews = make_previews(o, camera);
-    const FrameTimes times = render_frames(
-        o, *renderer, render::supersampled(camera, o.supersample), lighting, previews);
-    const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
-    render::write_png(sheet, tile(previews.thumbnails, o.columns), o.view.exposure);
-    const std::string video = make_animations(o, previews);
-    print_summary(o, renderer->stats(), camera, times, video, sheet, seconds_since(start));
-  };
+  return add_command<Options>(app, "relight", kAbout, add_flags, run);
 }
 
 }  // namespace prtr_app

@@ -64,34 +64,26 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_supersample_flag(cmd, o.supersample);
   cmd->add_option("--mesh", o.mesh, "Mesh (default: the one the set was baked from)");
   add_mesh_flags(cmd, o.mesh_flags);
-  cmd->add_option("--mode", o.mode, "Rendering path")
-      ->check(CLI::IsMember(render::mode_names()))
-      ->capture_default_str();
+  add_checked_option(cmd, "--mode", o.mode, "Rendering path",
+                     CLI::IsMember(render::kModeNames.names()));
   cmd->add_option("--transfer", o.transfer, "Raw transfer file (.prtx), for --mode uncompressed");
-  cmd->add_option("--rotate-deg", o.rotate_deg, "Environment rotation angle (degrees)")
-      ->check(angle_degrees())
-      ->capture_default_str();
+  add_checked_option(cmd, "--rotate-deg", o.rotate_deg, "Environment rotation angle (degrees)",
+                     angle_degrees());
   cmd->add_option("--register-budget", o.register_budget,
                   "vec4 registers per pass (0: what the GL context offers; thesis GPU: 256)")
       ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
-  cmd->add_option("--clusters-per-pass", o.clusters_per_pass,
-                  "Clusters per pass (0: as many as the budget holds)")
-      ->check(integer_in(0, 1 << 20))
-      ->capture_default_str();
+  add_checked_option(cmd, "--clusters-per-pass", o.clusters_per_pass,
+                     "Clusters per pass (0: as many as the budget holds)", integer_in(0, 1 << 20));
   cmd->add_option("--strategy", o.strategy,
                   "Super-cluster strategy: " + cpca::supercluster_strategy_names())
       ->capture_default_str();
-  cmd->add_option("--frames", o.frames, "Timed frames (median reported)")
-      ->check(integer_in(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--warmup", o.warmup, "Untimed frames first")
-      ->check(integer_in(0, 100000))
-      ->capture_default_str();
-  cmd->add_option("--spin-deg", o.degrees_per_frame,
-                  "Extra environment rotation per timed frame, so constants change every frame")
-      ->check(angle_degrees())
-      ->capture_default_str();
+  add_checked_option(cmd, "--frames", o.frames, "Timed frames (median reported)",
+                     integer_in(1, 100000));
+  add_checked_option(cmd, "--warmup", o.warmup, "Untimed frames first", integer_in(0, 100000));
+  add_checked_option(cmd, "--spin-deg", o.degrees_per_frame,
+                     "Extra environment rotation per timed frame, so constants change every frame",
+                     angle_degrees());
   add_view_flags(cmd, o.view);
   cmd->add_flag("--no-cull", o.no_cull, "Draw back faces too (open meshes)");
   cmd->add_flag("--no-reorder", o.no_reorder,
@@ -105,8 +97,8 @@ void add_flags(CLI::App* cmd, Options& o) {
 // The renderer options the flags describe; usage errors for flags the mode does not read.
 render::RendererOptions renderer_options(const Options& o, const CLI::App* cmd) {
   render::RendererOptions ro;
-  ro.mode = render::parse_mode(o.mode);
-  ro.accumulation = render::parse_accumulation(o.accumulation);
+  ro.mode = render::kModeNames.parse(o.mode);
+  ro.accumulation = render::kAccumulationNames.parse(o.accumulation);
   ro.register_budget = o.register_budget;
   ro.clusters_per_pass = o.clusters_per_pass;
   ro.cull_back_faces = !o.no_cull;
@@ -182,7 +174,7 @@ void print_report(const Options& o, const render::RenderStats& st,
         "mode        %s, %d pass(es), %d cluster(s) per pass, budget %d vec4 (%d per cluster), "
         "%s target\n",
         o.mode.c_str(), st.passes, st.clusters_per_pass, st.register_budget,
-        st.registers_per_cluster, render::accumulation_name(st.accumulation));
+        st.registers_per_cluster, render::kAccumulationNames.name(st.accumulation));
     std::printf("overdraw    %.4f (%llu triangles, drawn per pass %s)\n", st.average_overdraw,
                 static_cast<unsigned long long>(st.triangle_count),
                 count_list(st.triangles_per_pass).c_str());
@@ -209,77 +201,76 @@ void print_report(const Options& o, const render::RenderStats& st,
                  {"gl_ms", timing.gl_ms_median}};
     add_work(line, st.pass_work);
     line["supersample"] = o.supersample;
-    line["accumulation"] = render::accumulation_name(st.accumulation);
+    line["accumulation"] = render::kAccumulationNames.name(st.accumulation);
     line["image_frame_ms"] = image_ms;
     line["downsample_ms"] = downsample_ms;
     std::printf("%s\n", dump_json(line).c_str());
   }
 }
 
+void run(const Options& o, CLI::App* cmd) {
+  check_outputs({{"-o", o.output}, {"--png", o.png}}, {{"COMPRESSED", o.compressed},
+                                                       {"--probe", o.probe},
+                                                       {"--mesh", o.mesh},
+                                                       {"--transfer", o.transfer}});
+  const render::GlSelection gl = gl_selection(o.gl);
+  render::RendererOptions ro = renderer_options(o, cmd);
+  const render::Background background = resolve_background(o.view);
+  const Eigen::Vector3d axis = resolve_axis(o.view);
+  const cpca::CompressedSet set = cpca::read_compressed(o.compressed);
+  const meshes::Mesh mesh = load_checked_mesh(o, set);
+  const std::optional<prt::TransferSet> transfer = load_checked_transfer(o, set);
+  const probes::Probe probe = probes::load_probe(o.probe);
+  const prt::ShLighting lighting = prt::project(probe, transfer ? transfer->order : set.order);
+  const Eigen::Matrix3d rotation = prt::axis_angle(axis, o.rotate_deg * std::numbers::pi / 180.0);
+  const render::Camera camera = resolve_camera(o.view, mesh);
+
+  render::GlContext context(gl);
+  std::unique_ptr<render::Renderer> renderer;
+  try {
+    if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
+      ro.groups = render::group_for_renderer(mesh, set, context, o.register_budget,
+                                             o.clusters_per_pass, o.strategy);
+    renderer =
+        std::make_unique<render::Renderer>(mesh, &set, transfer ? &*transfer : nullptr, &probe, ro);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  renderer->set_background(background);
+  const render::TimingSummary timing = render::measure(*renderer, camera, lighting, rotation, axis,
+                                                       o.degrees_per_frame, o.frames, o.warmup);
+  // One counted frame at the timed size; the timed frames draw as users' frames do.
+  renderer->set_count_work(true);
+  renderer->set_count_primitives(ro.mode == render::Mode::kMultipass);
+  renderer->render(camera, lighting, rotation);
+  const render::RenderStats counted = renderer->stats();
+  renderer->set_count_work(false);
+  renderer->set_count_primitives(false);
+  const render::Camera image_camera = render::supersampled(camera, o.supersample);
+  const double image_ms = renderer->render(image_camera, lighting, rotation).total_ms;
+  const render::Image samples = renderer->read_image();
+  const auto filter_start = std::chrono::steady_clock::now();
+  const render::Image image = render::box_downsample(samples, o.supersample);
+  const double downsample_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - filter_start)
+          .count();
+  render::write_exr(o.output, image);
+  if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
+  const render::RenderStats& st = counted;
+  if (!st.measured_triangles.empty() && st.measured_triangles != st.triangles_per_pass)
+    throw std::runtime_error("GL counted " + count_list(st.measured_triangles) +
+                             " triangles per pass but the grouping predicts " +
+                             count_list(st.triangles_per_pass) + " (a renderer bug)");
+  print_report(o, st, timing, image_ms, downsample_ms);
+}
+
+constexpr const char* kAbout =
+    "Relight a compressed bake (.prtc) under a rotated probe; write EXR/PNG and FPS";
+
 }  // namespace
 
 Runner add_render_command(CLI::App& app) {
-  auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "render", "Relight a compressed bake (.prtc) under a rotated probe; write EXR/PNG and FPS");
-  add_flags(cmd, *opt);
-
-  return [opt, cmd] {
-    const Options& o = *opt;
-    check_outputs({{"-o", o.output}, {"--png", o.png}}, {{"COMPRESSED", o.compressed},
-                                                         {"--probe", o.probe},
-                                                         {"--mesh", o.mesh},
-                                                         {"--transfer", o.transfer}});
-    const render::GlSelection gl = gl_selection(o.gl);
-    render::RendererOptions ro = renderer_options(o, cmd);
-    const render::Background background = resolve_background(o.view);
-    const Eigen::Vector3d axis = resolve_axis(o.view);
-    const cpca::CompressedSet set = cpca::read_compressed(o.compressed);
-    const meshes::Mesh mesh = load_checked_mesh(o, set);
-    const std::optional<prt::TransferSet> transfer = load_checked_transfer(o, set);
-    const probes::Probe probe = probes::load_probe(o.probe);
-    const prt::ShLighting lighting = prt::project(probe, transfer ? transfer->order : set.order);
-    const Eigen::Matrix3d rotation = prt::axis_angle(axis, o.rotate_deg * std::numbers::pi / 180.0);
-    const render::Camera camera = resolve_camera(o.view, mesh);
-
-    render::GlContext context(gl);
-    std::unique_ptr<render::Renderer> renderer;
-    try {
-      if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
-        ro.groups = render::group_for_renderer(mesh, set, context, o.register_budget,
-                                               o.clusters_per_pass, o.strategy);
-      renderer = std::make_unique<render::Renderer>(mesh, &set, transfer ? &*transfer : nullptr,
-                                                    &probe, ro);
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
-    }
-    renderer->set_background(background);
-    const render::TimingSummary timing = render::measure(
-        *renderer, camera, lighting, rotation, axis, o.degrees_per_frame, o.frames, o.warmup);
-    // One counted frame at the timed size; the timed frames draw as users' frames do.
-    renderer->set_count_work(true);
-    renderer->set_count_primitives(ro.mode == render::Mode::kMultipass);
-    renderer->render(camera, lighting, rotation);
-    const render::RenderStats counted = renderer->stats();
-    renderer->set_count_work(false);
-    renderer->set_count_primitives(false);
-    const render::Camera image_camera = render::supersampled(camera, o.supersample);
-    const double image_ms = renderer->render(image_camera, lighting, rotation).total_ms;
-    const render::Image samples = renderer->read_image();
-    const auto filter_start = std::chrono::steady_clock::now();
-    const render::Image image = render::box_downsample(samples, o.supersample);
-    const double downsample_ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - filter_start)
-            .count();
-    render::write_exr(o.output, image);
-    if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
-    const render::RenderStats& st = counted;
-    if (!st.measured_triangles.empty() && st.measured_triangles != st.triangles_per_pass)
-      throw std::runtime_error("GL counted " + count_list(st.measured_triangles) +
-                               " triangles per pass but the grouping predicts " +
-                               count_list(st.triangles_per_pass) + " (a renderer bug)");
-    print_report(o, st, timing, image_ms, downsample_ms);
-  };
+  return add_command<Options>(app, "render", kAbout, add_flags, run);
 }
 
 }  // namespace prtr_app

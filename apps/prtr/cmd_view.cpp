@@ -51,15 +51,14 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--probe", o.probe,
                   "Light probe (EXR/HDR); the page offers every *.exr/*.hdr in its folder")
       ->required();
-  cmd->add_option("--mode", o.mode, "Initial rendering path")
-      ->check(CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu", "uncompressed"}))
-      ->capture_default_str();
+  add_checked_option(
+      cmd, "--mode", o.mode, "Initial rendering path",
+      CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu", "uncompressed"}));
   cmd->add_option("--strategy", o.strategy, "Initial super-cluster strategy")
       ->capture_default_str();
-  cmd->add_option("--register-budget", o.register_budget,
-                  "Initial vec4 registers per pass (0: what the GL context offers)")
-      ->check(integer_in(0, 1 << 20))
-      ->capture_default_str();
+  add_checked_option(cmd, "--register-budget", o.register_budget,
+                     "Initial vec4 registers per pass (0: what the GL context offers)",
+                     integer_in(0, 1 << 20));
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
   add_bake_flags(cmd, o.bake);
   o.view.width = 960;  // the page's default size; it can ask for others
@@ -70,9 +69,8 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_gl_flags(cmd, o.gl);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   cmd->add_option("--host", o.server.host, "Address to listen on")->capture_default_str();
-  cmd->add_option("--port", o.server.port, "Port to listen on (0: any free port)")
-      ->check(integer_in(0, 65535))
-      ->capture_default_str();
+  add_checked_option(cmd, "--port", o.server.port, "Port to listen on (0: any free port)",
+                     integer_in(0, 65535));
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bars");
 }
 
@@ -122,11 +120,11 @@ Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::Compresse
               {"default_register_budget", scene.default_register_budget},
               {"registers_per_cluster", scene.registers_per_cluster},
               {"still_samples", o.supersample},
-              {"modes", render::mode_names()},
+              {"modes", render::kModeNames.names()},
               {"strategies", strategies},
               {"probes", names},
               {"defaults",
-               {{"mode", render::mode_name(d.mode)},
+               {{"mode", render::kModeNames.name(d.mode)},
                 {"strategy", d.strategy},
                 {"probe", d.probe},
                 {"exposure", d.exposure},
@@ -143,7 +141,7 @@ ViewState initial_state(const Options& o, int probe) {
   ViewState s;
   s.width = o.view.width;
   s.height = o.view.height;
-  s.mode = render::parse_mode(o.mode);
+  s.mode = render::kModeNames.parse(o.mode);
   s.strategy = o.strategy;
   s.register_budget = o.register_budget;
   s.probe = probe;
@@ -151,52 +149,49 @@ ViewState initial_state(const Options& o, int probe) {
   return s;
 }
 
+void run(const Options& o, CLI::App*) {
+  const prt::BakeOptions bake = resolve_bake_flags(o.bake);
+  const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
+  const render::Background background = resolve_background(o.view);
+  const Eigen::Vector3d axis = resolve_axis(o.view);
+  const render::CameraPlacement placement = resolve_placement(o.view);
+  const render::GlSelection gl = gl_selection(o.gl);
+  int probe_index = 0;
+  const std::vector<fs::path> probes = scan_probes(o.probe, probe_index);
+  ServedInfo served;
+  served.defaults = initial_state(o, probe_index);
+  const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+  resolve_camera(o.view, mesh);
+  probes::load_probe(o.probe);  // fail before the long work
+  const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
+  const pipeline::Reporter reporter = stderr_reporter(o.quiet);
+  const pipeline::CacheResult transfer = pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
+  const pipeline::CompressCacheResult compressed =
+      pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
+  const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
+  viewer::ViewScene scene({&mesh, &set, transfer.path, probes, placement, background, axis, gl});
+  served.limits = {int(probes.size()), set.cluster_count, true};
+  served.limits.max_register_budget = scene.info().default_register_budget;
+  served.limits.registers_per_cluster = scene.info().registers_per_cluster;
+  // The initial state renders once here, so a flag the renderer refuses exits 2 now.
+  const auto first = scene.render(served.defaults);
+  if (!first->request_error.empty()) throw UsageError(first->request_error);
+  if (!first->server_error.empty()) throw std::runtime_error(first->server_error);
+  served.info = info_json(o, mesh, set, compressed.summary, scene.info(), probes, served);
+  std::printf("prtr view: %s, %d clusters x %d PCs, order %d; first frame %.0f ms\n",
+              o.mesh.c_str(), set.cluster_count, set.component_count, set.order,
+              first->stats.render_ms);
+  viewer::serve_view(scene, served, o.server);
+}
+
+constexpr const char* kAbout =
+    "Bake, compress (cached) and serve MESH under PROBE to a browser: drag to relight, with "
+    "render modes, probes, overlays and live statistics";
+
 }  // namespace
 
 Runner add_view_command(CLI::App& app) {
-  auto opt = std::make_shared<Options>();
-  CLI::App* cmd = app.add_subcommand(
-      "view",
-      "Bake, compress (cached) and serve MESH under PROBE to a browser: drag to relight, with "
-      "render modes, probes, overlays and live statistics");
-  add_flags(cmd, *opt);
-
-  return [opt] {
-    const Options& o = *opt;
-    const prt::BakeOptions bake = resolve_bake_flags(o.bake);
-    const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
-    const render::Background background = resolve_background(o.view);
-    const Eigen::Vector3d axis = resolve_axis(o.view);
-    const render::CameraPlacement placement = resolve_placement(o.view);
-    const render::GlSelection gl = gl_selection(o.gl);
-    int probe_index = 0;
-    const std::vector<fs::path> probes = scan_probes(o.probe, probe_index);
-    ServedInfo served;
-    served.defaults = initial_state(o, probe_index);
-    const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
-    resolve_camera(o.view, mesh);
-    probes::load_probe(o.probe);  // fail before the long work
-    const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
-    const pipeline::Reporter reporter = stderr_reporter(o.quiet);
-    const pipeline::CacheResult transfer =
-        pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
-    const pipeline::CompressCacheResult compressed =
-        pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
-    const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
-    viewer::ViewScene scene({&mesh, &set, transfer.path, probes, placement, background, axis, gl});
-    served.limits = {int(probes.size()), set.cluster_count, true};
-    served.limits.max_register_budget = scene.info().default_register_budget;
-    served.limits.registers_per_cluster = scene.info().registers_per_cluster;
-    // The initial state renders once here, so a flag the renderer refuses exits 2 now.
-    const auto first = scene.render(served.defaults);
-    if (!first->request_error.empty()) throw UsageError(first->request_error);
-    if (!first->server_error.empty()) throw std::runtime_error(first->server_error);
-    served.info = info_json(o, mesh, set, compressed.summary, scene.info(), probes, served);
-    std::printf("prtr view: %s, %d clusters x %d PCs, order %d; first frame %.0f ms\n",
-                o.mesh.c_str(), set.cluster_count, set.component_count, set.order,
-                first->stats.render_ms);
-    viewer::serve_view(scene, served, o.server);
-  };
+  return add_command<Options>(app, "view", kAbout, add_flags, run);
 }
 
 }  // namespace prtr_app

@@ -6,10 +6,22 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
 
 namespace prtr_app {
 
 using Runner = std::function<void()>;
+
+// Registers subcommand `name` with its flags; the runner calls run(options, subcommand) once
+// the command line has been parsed into them.
+template <class Options>
+Runner add_command(CLI::App& app, const char* name, const char* about,
+                   void (*add_flags)(CLI::App*, Options&), void (*run)(const Options&, CLI::App*)) {
+  auto options = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(name, about);
+  add_flags(cmd, *options);
+  return [options, cmd, run] { run(*options, cmd); };
+}
 
 Runner add_mesh_command(CLI::App& app);
 Runner add_probe_command(CLI::App& app);

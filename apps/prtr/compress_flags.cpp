@@ -10,20 +10,18 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   cpca::CompressOptions& o = f.compress;
   const bool per_row = set == CompressFlagSet::kPerRow;
   if (!per_row) {
-    cmd->add_option("--clusters", o.clusters, "Number of CPCA clusters K")
-        ->check(integer_in(1, 65536))
-        ->capture_default_str();
+    add_checked_option(cmd, "--clusters", o.clusters, "Number of CPCA clusters K",
+                       integer_in(1, 65536));
   }
-  cmd->add_option("--pcs", o.components, "Principal components per cluster N")
-      ->check(integer_in(0, 1 << 20))
-      ->capture_default_str();
+  add_checked_option(cmd, "--pcs", o.components, "Principal components per cluster N",
+                     integer_in(0, 1 << 20));
   if (!per_row) {
     cmd->add_option("--method", f.method,
                     "lbg: LBG then PCA per cluster; iterative: Sloan et al. 2003 iterative CPCA; "
                     "patch-first: one METIS patch per pass, CPCA inside each; joint: local "
                     "search on Average SE + lambda x overdraw; patch-joint: that search "
                     "started from patch-first")
-        ->check(CLI::IsMember(cpca::cluster_method_names()))
+        ->check(CLI::IsMember(cpca::kClusterMethodNames.names()))
         ->capture_default_str();
   }
   cmd->add_option("--alpha", o.alpha,
@@ -34,34 +32,29 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
     cmd->add_flag("--overdraw-reduction", o.overdraw_reduction,
                   "Move border vertices to neighbouring clusters to cut multi-cluster triangles");
   }
-  cmd->add_option("--overdraw-tolerance", o.overdraw.tolerance,
-                  "Overdraw reduction: largest error increase per move, in units of the Average SE")
-      ->check(number_in(0.0, 1e6))
-      ->capture_default_str();
+  add_checked_option(
+      cmd, "--overdraw-tolerance", o.overdraw.tolerance,
+      "Overdraw reduction: largest error increase per move, in units of the Average SE",
+      number_in(0.0, 1e6));
   if (set != CompressFlagSet::kCompress) return;
   cmd->add_option("--pca", f.pca, "power: power iteration (SLF paper); eigen: Eigen's solver")
-      ->check(CLI::IsMember(cpca::pca_solver_names()))
+      ->check(CLI::IsMember(cpca::kPcaSolverNames.names()))
       ->capture_default_str();
-  cmd->add_option("--seed", o.seed, "Seed of the hyper-box initialisation")
-      ->check(unsigned_integer())
-      ->capture_default_str();
-  cmd->add_option("--threshold", o.lbg_threshold,
-                  "LBG stops when the energy ratio (E_{i-1} - E_i) / E_{i-1} falls below this")
-      ->check(number_in(0.0, 1.0))
-      ->capture_default_str();
-  cmd->add_option("--max-iterations", o.lbg_max_iterations, "LBG iteration cap")
-      ->check(integer_in(1, 100000))
-      ->capture_default_str();
-  f.per_pass = cmd->add_option("--clusters-per-pass", o.clusters_per_pass,
-                               "patch-first / joint: clusters one render pass holds (16 at the "
-                               "default budget for order 6 and 8 PCs, 3 at the thesis's)")
-                   ->check(integer_in(1, 1 << 20))
-                   ->capture_default_str();
-  f.lambda = cmd->add_option("--lambda", o.lambda,
-                             "joint: overdraw weight, in units of the start's Average SE per "
-                             "unit of average overdraw (0 = iterative CPCA)")
-                 ->check(number_in(0.0, 1e6))
-                 ->capture_default_str();
+  add_checked_option(cmd, "--seed", o.seed, "Seed of the hyper-box initialisation",
+                     unsigned_integer());
+  add_checked_option(cmd, "--threshold", o.lbg_threshold,
+                     "LBG stops when the energy ratio (E_{i-1} - E_i) / E_{i-1} falls below this",
+                     number_in(0.0, 1.0));
+  add_checked_option(cmd, "--max-iterations", o.lbg_max_iterations, "LBG iteration cap",
+                     integer_in(1, 100000));
+  f.per_pass = add_checked_option(cmd, "--clusters-per-pass", o.clusters_per_pass,
+                                  "patch-first / joint: clusters one render pass holds (16 at the "
+                                  "default budget for order 6 and 8 PCs, 3 at the thesis's)",
+                                  integer_in(1, 1 << 20));
+  f.lambda = add_checked_option(cmd, "--lambda", o.lambda,
+                                "joint: overdraw weight, in units of the start's Average SE per "
+                                "unit of average overdraw (0 = iterative CPCA)",
+                                number_in(0.0, 1e6));
   f.cap = cmd->add_option("--overdraw-cap", o.overdraw_cap,
                           "joint: no vertex move may raise the average overdraw above this "
                           "(0 = no cap; else >= 1), so a small --lambda spends the allowance "
@@ -80,8 +73,8 @@ bool given(const CLI::Option* option) {
 
 cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
   cpca::CompressOptions o = f.compress;
-  o.method = cpca::parse_cluster_method(f.method);
-  o.solver = cpca::parse_pca_solver(f.pca);
+  o.method = cpca::kClusterMethodNames.parse(f.method);
+  o.solver = cpca::kPcaSolverNames.parse(f.pca);
   const bool joint =
       o.method == cpca::ClusterMethod::kJoint || o.method == cpca::ClusterMethod::kPatchJoint;
   const bool designed = joint || o.method == cpca::ClusterMethod::kPatchFirst;

@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -102,6 +103,33 @@ inline void check_outputs(const std::vector<common::NamedPath>& outputs,
                           const std::vector<common::NamedPath>& inputs) {
   if (const std::string problem = common::outputs_problem(outputs, inputs); !problem.empty())
     throw UsageError(problem);
+}
+
+// "0.5,0.4,0.3" as numbers (std::stod's syntax, each item whole); nullopt if an item is not
+// a number. Ranges and counts are the caller's to check.
+inline std::optional<std::vector<double>> parse_number_list(const std::string& text) {
+  std::vector<double> values;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', begin), text.size());
+    const std::string item = text.substr(begin, comma - begin);
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(item, &used));
+      if (used != item.size()) return std::nullopt;
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    begin = comma + 1;
+  }
+  return values;
+}
+
+// A flag checked by `check` whose default shows in --help: the form most flags take.
+template <class T>
+CLI::Option* add_checked_option(CLI::App* cmd, const std::string& name, T& value,
+                                const std::string& help, const CLI::Validator& check) {
+  return cmd->add_option(name, value, help)->check(check)->capture_default_str();
 }
 
 }  // namespace prtr_app

@@ -26,12 +26,11 @@ void add_gl_flags(CLI::App* cmd, GlFlags& flags) {
 }
 
 void add_accumulation_flag(CLI::App* cmd, std::string& name) {
-  cmd->add_option("--accumulation", name,
-                  "Format the passes add into: rgba32f, rgba16f (six times the blending rate "
-                  "on a GPU, 11 significant bits), or auto (rgba16f on a GPU, rgba32f on "
-                  "Mesa's software rasterisers)")
-      ->check(CLI::IsMember(render::accumulation_names()))
-      ->capture_default_str();
+  add_checked_option(
+      cmd, "--accumulation", name,
+      "Format the passes add into: rgba32f, rgba16f (six times the blending rate on a GPU, 11 "
+      "significant bits), or auto (rgba16f on a GPU, rgba32f on Mesa's software rasterisers)",
+      CLI::IsMember(render::kAccumulationNames.names()));
 }
 
 render::GlSelection gl_selection(const GlFlags& flags) {

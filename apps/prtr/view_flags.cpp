@@ -4,47 +4,29 @@
 #include "flag_checks.h"
 
 #include <cmath>
-#include <sstream>
 #include <vector>
 
 namespace prtr_app {
 
 void add_view_flags(CLI::App* cmd, ViewFlags& f) {
-  cmd->add_option("--width", f.width, "Image width")
-      ->check(integer_in(1, 16384))
-      ->capture_default_str();
-  cmd->add_option("--height", f.height, "Image height")
-      ->check(integer_in(1, 16384))
-      ->capture_default_str();
+  add_checked_option(cmd, "--width", f.width, "Image width", integer_in(1, 16384));
+  add_checked_option(cmd, "--height", f.height, "Image height", integer_in(1, 16384));
   cmd->add_option("--eye", f.eye, "Camera position x,y,z (default: frames the bounding sphere)");
   cmd->add_option("--target", f.target, "Camera target x,y,z (default: the sphere's centre)");
   cmd->add_option("--up", f.up, "Camera up x,y,z (default: 0,1,0)");
   // Open at both ends; the camera refuses 0 and 180 by name.
-  cmd->add_option("--fov", f.fov, "Vertical field of view (degrees)")
-      ->check(number_in(0, 180))
-      ->capture_default_str();
+  add_checked_option(cmd, "--fov", f.fov, "Vertical field of view (degrees)", number_in(0, 180));
   cmd->add_option("--background", f.background, "probe, black, or a colour R,G,B")
       ->capture_default_str();
   // 2^64 times a radiance of 1e20 is still a float; past it the PNG would be all Inf.
-  cmd->add_option("--exposure", f.exposure, "PNG exposure in stops")
-      ->check(number_in(-64, 64))
-      ->capture_default_str();
+  add_checked_option(cmd, "--exposure", f.exposure, "PNG exposure in stops", number_in(-64, 64));
   cmd->add_option("--axis", f.axis, "Environment rotation axis x,y,z")->capture_default_str();
 }
 
 Eigen::Vector3d parse_vector(const std::string& text, const char* flag) {
-  std::vector<double> values;
-  std::stringstream ss(text);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    try {
-      std::size_t used = 0;
-      values.push_back(std::stod(item, &used));
-      if (used != item.size()) throw std::invalid_argument(item);
-    } catch (const std::exception&) {
-      throw UsageError(std::string(flag) + ": '" + text + "' is not a list of numbers");
-    }
-  }
+  const auto parsed = parse_number_list(text);
+  if (!parsed) throw UsageError(std::string(flag) + ": '" + text + "' is not a list of numbers");
+  const std::vector<double>& values = *parsed;
   if (values.size() != 3)
     throw UsageError(std::string(flag) + " takes 3 comma-separated numbers x,y,z, got '" + text +
                      "'");

@@ -142,18 +142,16 @@ void check_distributed(const CompressOptions& o, const Distribution& dist) {
 
 CompressedSet new_set(const CompressOptions& options, const DataLayout& layout,
                       std::vector<std::uint32_t> cluster_of) {
-  CompressedSet set;
-  set.order = layout.order;
-  set.channels = layout.channels;
-  set.columns = layout.columns;
-  set.cluster_count = options.clusters;
-  set.component_count = options.components;
-  set.method = options.method;
-  set.alpha = options.alpha;
-  set.overdraw_reduction = options.overdraw_reduction;
-  set.seed = options.seed;
-  set.cluster_of = std::move(cluster_of);
-  return set;
+  return {.order = layout.order,
+          .channels = layout.channels,
+          .columns = layout.columns,
+          .cluster_count = options.clusters,
+          .component_count = options.components,
+          .method = options.method,
+          .alpha = options.alpha,
+          .overdraw_reduction = options.overdraw_reduction,
+          .seed = options.seed,
+          .cluster_of = std::move(cluster_of)};
 }
 
 // Stage 3, iterative CPCA: reassign to the best-reconstructing cluster, refit, until the

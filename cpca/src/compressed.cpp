@@ -1,43 +1,10 @@
 #include "cpca/compressed.h"
 
-#include "common/enum_names.h"
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace cpca {
-
-namespace {
-constexpr common::EnumName<ClusterMethod> kMethodNames[] = {
-    {ClusterMethod::kLbg, "lbg"},
-    {ClusterMethod::kIterative, "iterative"},
-    {ClusterMethod::kPatchFirst, "patch-first"},
-    {ClusterMethod::kJoint, "joint"},
-    {ClusterMethod::kPatchJoint, "patch-joint"}};
-constexpr common::EnumName<PcaSolver> kSolverNames[] = {{PcaSolver::kPowerIteration, "power"},
-                                                        {PcaSolver::kEigen, "eigen"}};
-}  // namespace
-
-const char* cluster_method_name(ClusterMethod method) {
-  return common::enum_name<ClusterMethod>(kMethodNames, method);
-}
-ClusterMethod parse_cluster_method(const std::string& name) {
-  return common::parse_enum<ClusterMethod>(kMethodNames, name, "clustering method");
-}
-std::vector<std::string> cluster_method_names() {
-  return common::enum_names<ClusterMethod>(kMethodNames);
-}
-
-const char* pca_solver_name(PcaSolver solver) {
-  return common::enum_name<PcaSolver>(kSolverNames, solver);
-}
-PcaSolver parse_pca_solver(const std::string& name) {
-  return common::parse_enum<PcaSolver>(kSolverNames, name, "PCA solver");
-}
-std::vector<std::string> pca_solver_names() {
-  return common::enum_names<PcaSolver>(kSolverNames);
-}
 
 void reconstruct_vertex(const CompressedSet& set, std::uint64_t p, float* out) {
   const int k = int(set.cluster_of[p]);

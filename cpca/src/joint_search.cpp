@@ -373,15 +373,14 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   CompressedSet set = joint_start(data, options, geometry, rep, error, pass_of);
   const double start_seconds = seconds(t);
   t = Clock::now();
-  JointSearchOptions jo;
-  jo.lambda = options.lambda;
-  jo.per_pass = options.clusters_per_pass;
-  jo.max_steps = options.cpca_max_iterations;
-  jo.threshold = options.cpca_threshold;
-  jo.candidates = options.cpca_candidates;
-  jo.solver = options.solver;
-  jo.seed = options.seed;
-  jo.overdraw_cap = options.overdraw_cap;
+  const JointSearchOptions jo{.lambda = options.lambda,
+                              .per_pass = options.clusters_per_pass,
+                              .max_steps = options.cpca_max_iterations,
+                              .threshold = options.cpca_threshold,
+                              .candidates = options.cpca_candidates,
+                              .solver = options.solver,
+                              .seed = options.seed,
+                              .overdraw_cap = options.overdraw_cap};
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
   set.method = options.method;

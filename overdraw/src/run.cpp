@@ -78,13 +78,13 @@ ImageDifference image_error(const render::Image& image, const render::Image& ref
 
 std::string describe_bake(const prt::TransferSet& t) {
   std::ostringstream b;
-  b << prt::transfer_kind_name(t.kind) << " order " << t.order << ", " << t.channels
-    << " channel(s), " << prt::material_name(t.material.kind) << " (albedo "
+  b << prt::kTransferKindNames.name(t.kind) << " order " << t.order << ", " << t.channels
+    << " channel(s), " << prt::kMaterialNames.name(t.material.kind) << " (albedo "
     << t.material.albedo.x() << ", specular " << t.material.specular;
   if (t.material.kind == prt::MaterialKind::kPhong) b << ", exponent " << t.material.exponent;
   if (t.material.kind == prt::MaterialKind::kCookTorrance)
     b << ", roughness " << t.material.roughness << ", f0 " << t.material.f0 << ", "
-      << prt::masking_name(t.material.masking) << " masking";
+      << prt::kMaskingNames.name(t.material.masking) << " masking";
   b << "), " << t.samples << " samples, " << t.bounces << " bounce(s)";
   return b.str();
 }
@@ -193,7 +193,7 @@ ModeTiming measure_mode(const Scene& s, const cpca::CompressedSet& set, int k, r
   r.set_background(kBlack);
   const render::TimingSummary t = time_frames(r, s, s.plan.frames, s.plan.warmup);
   const ImageDifference e = image_error(final_image(r, s), s.reference);
-  return {k, render::mode_name(mode), t.fps, t.frame_ms_median, e.rmse, e.relative()};
+  return {k, render::kModeNames.name(mode), t.fps, t.frame_ms_median, e.rmse, e.relative()};
 }
 
 // One compression (K x method) as every row of it sees it.
@@ -494,7 +494,7 @@ void measure_method(Rows& rows, int k, const MethodPreset& method, int per_pass,
                            " its clusters per pass were designed for");
   if (s.plan.modes && modes)
     for (render::Mode mode : {render::Mode::kSinglepass, render::Mode::kDecoupled}) {
-      rows.progress.show(c.label() + ": " + render::mode_name(mode));
+      rows.progress.show(c.label() + ": " + render::kModeNames.name(mode));
       rows.report.modes.push_back(measure_mode(s, c.set, k, mode));
     }
   measure_compression(s, c, rows.report, rows.timed, rows.progress);

@@ -44,7 +44,7 @@ prt::TransferSet run_bake(const meshes::Mesh& mesh, const std::string& mesh_name
   std::snprintf(line, sizeof line,
                 "bake: %zu vertices, %s order %d, %d samples, %d bounce(s); about %s of "
                 "memory, %.1f M shadow rays, roughly %.0f s",
-                mesh.vertex_count(), prt::transfer_kind_name(options.kind), options.order,
+                mesh.vertex_count(), prt::kTransferKindNames.name(options.kind), options.order,
                 options.samples, options.bounces, common::format_bytes(estimate.bytes).c_str(),
                 double(estimate.rays) / 1e6, estimate.seconds);
   reporter.tell(line);
@@ -174,17 +174,17 @@ void discard(const fs::path& entry, const std::exception& why, const Reporter& r
 std::string header_mismatch(const prt::TransferSet& t, const prt::BakeOptions& o) {
   const prt::Material& a = t.material;
   const prt::Material& b = o.material;
-  if (t.kind != o.kind) return std::string("kind ") + prt::transfer_kind_name(t.kind);
+  if (t.kind != o.kind) return std::string("kind ") + prt::kTransferKindNames.name(t.kind);
   if (t.order != o.order) return "order " + std::to_string(t.order);
   if (t.samples != o.samples) return std::to_string(t.samples) + " samples";
   if (t.bounces != o.bounces) return std::to_string(t.bounces) + " bounces";
   if (t.seed != o.seed) return "seed " + std::to_string(t.seed);
   if (t.kind == prt::TransferKind::kGlossy && t.view_fit != o.view_fit)
-    return std::string("view fit ") + prt::view_fit_name(t.view_fit);
+    return std::string("view fit ") + prt::kViewFitNames.name(t.view_fit);
   if (a.kind != b.kind || a.albedo != b.albedo || a.specular != b.specular ||
       a.exponent != b.exponent || a.roughness != b.roughness || a.f0 != b.f0 ||
       a.masking != b.masking)
-    return std::string("another material (") + prt::material_name(a.kind) + ")";
+    return std::string("another material (") + prt::kMaterialNames.name(a.kind) + ")";
   return {};
 }
 

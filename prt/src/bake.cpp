@@ -84,7 +84,7 @@ void validate(const BakeOptions& o) {
   }
   o.material.validate();
   if (!view_fit_renderable(o.view_fit)) {
-    throw std::invalid_argument(std::string("--view-fit ") + view_fit_name(o.view_fit) +
+    throw std::invalid_argument(std::string("--view-fit ") + kViewFitNames.name(o.view_fit) +
                                 " is for the benchmarks only; bake with least-squares, even or "
                                 "hemisphere");
   }

@@ -14,8 +14,6 @@
 // its own partial B; the partials are summed in chunk order, so the result is deterministic.
 #include "prt/material.h"
 
-#include "common/enum_names.h"
-
 #include "prt/sh.h"
 #include "prt/zonal.h"
 
@@ -245,34 +243,6 @@ void Material::validate() const {
       }
     }
   }
-}
-
-namespace {
-constexpr common::EnumName<MaterialKind> kMaterialNames[] = {
-    {MaterialKind::kLambert, "lambert"},
-    {MaterialKind::kPhong, "phong"},
-    {MaterialKind::kCookTorrance, "cook-torrance"}};
-}  // namespace
-
-const char* material_name(MaterialKind kind) {
-  return common::enum_name<MaterialKind>(kMaterialNames, kind);
-}
-
-MaterialKind parse_material(const std::string& name) {
-  return common::parse_enum<MaterialKind>(kMaterialNames, name, "material");
-}
-
-namespace {
-constexpr common::EnumName<Masking> kMaskingNames[] = {{Masking::kSmith, "smith"},
-                                                       {Masking::kVGroove, "v-groove"}};
-}  // namespace
-
-const char* masking_name(Masking masking) {
-  return common::enum_name<Masking>(kMaskingNames, masking);
-}
-
-Masking parse_masking(const std::string& name) {
-  return common::parse_enum<Masking>(kMaskingNames, name, "masking");
 }
 
 double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,

@@ -95,7 +95,7 @@ std::string first_difference(const TransferSet& a, const TransferSet& b) {
   const std::pair<const char*, std::pair<std::string, std::string>> fields[] = {
       {"mesh hash", {common::hex64(a.mesh_hash), common::hex64(b.mesh_hash)}},
       {"vertex count", {str(a.vertex_count), str(b.vertex_count)}},
-      {"kind", {transfer_kind_name(a.kind), transfer_kind_name(b.kind)}},
+      {"kind", {kTransferKindNames.name(a.kind), kTransferKindNames.name(b.kind)}},
       {"order", {str(a.order), str(b.order)}},
       {"samples", {str(a.samples), str(b.samples)}},
       {"bounces", {str(a.bounces), str(b.bounces)}},

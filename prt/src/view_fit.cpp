@@ -2,8 +2,6 @@
 // quadrature of the view integral, so brdf_matrix keeps one product quadrature for all.
 #include "prt/view_fit.h"
 
-#include "common/enum_names.h"
-
 #include "prt/sh.h"
 
 #include <Eigen/Cholesky>
@@ -15,11 +13,6 @@
 namespace prt {
 namespace {
 
-constexpr common::EnumName<ViewFit> kViewFitNames[] = {{ViewFit::kHemisphere, "hemisphere"},
-                                                       {ViewFit::kEven, "even"},
-                                                       {ViewFit::kLeastSquares, "least-squares"},
-                                                       {ViewFit::kHemisphericalHarmonics, "hsh"}};
-
 // HSH's direction: cos theta' = 2 z - 1 and the tangent part scaled by sin theta' / sin theta,
 // which is sqrt(4 z / (1 + z)) in closed form (no division by sin theta at the pole).
 Eigen::Vector3d hsh_direction(const Eigen::Vector3d& v) {
@@ -29,14 +22,6 @@ Eigen::Vector3d hsh_direction(const Eigen::Vector3d& v) {
 }
 
 }  // namespace
-
-const char* view_fit_name(ViewFit fit) {
-  return common::enum_name<ViewFit>(kViewFitNames, fit);
-}
-
-ViewFit parse_view_fit(const std::string& name) {
-  return common::parse_enum<ViewFit>(kViewFitNames, name, "view fit");
-}
 
 bool view_fit_renderable(ViewFit fit) {
   return fit == ViewFit::kHemisphere || fit == ViewFit::kEven || fit == ViewFit::kLeastSquares;

@@ -433,14 +433,7 @@ class SinglepassPath : public ClusterPath {
     program_ = GlProgram("single-pass shading",
                          compressed_vertex_shader(layout_, ConstantAccess::kStorage, 0, false),
                          radiance_fragment_shader(), true);
-  }
-  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kConstantsBinding, constant_buffer_);
-    draw_whole(program_, camera, queries);
-  }
-  std::vector<Rgb> capture(const Camera& camera) override {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kConstantsBinding, constant_buffer_);
-    return capture_whole(program_, camera);
+    shade_whole(&program_, kConstantsBinding, constant_buffer_);
   }
 
  private:
@@ -506,7 +499,7 @@ class CpuPath : public ClusterPath {
 
 std::unique_ptr<RenderPath> make_cluster_path(const PathInput& in) {
   if (!in.set)
-    throw std::invalid_argument("mode " + std::string(mode_name(in.options.mode)) +
+    throw std::invalid_argument("mode " + std::string(kModeNames.name(in.options.mode)) +
                                 " needs a compressed set");
   cpca::validate(*in.set);
   if (in.set->vertex_count != in.mesh.vertex_count())
@@ -526,7 +519,7 @@ std::unique_ptr<RenderPath> make_cluster_path(const PathInput& in) {
     case Mode::kUncompressed:
       break;
   }
-  throw std::invalid_argument("mode " + std::string(mode_name(in.options.mode)) +
+  throw std::invalid_argument("mode " + std::string(kModeNames.name(in.options.mode)) +
                               " is not a cluster path");
 }
 

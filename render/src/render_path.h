@@ -28,14 +28,16 @@ class RenderPath {
   // l' (n x 3), computed and uploaded.
   virtual void update(const Eigen::MatrixXd& lit, const Camera& camera) = 0;
   // Draws the mesh into the bound, cleared framebuffer (depth test and culling set); with
-  // `queries` (one per pass()), counts each pass's primitives.
-  virtual void draw(const Camera& camera, const std::vector<GLuint>& queries) = 0;
+  // `queries` (one per pass()), counts each pass's primitives. By default: one draw of the
+  // program given to shade_whole().
+  virtual void draw(const Camera& camera, const std::vector<GLuint>& queries);
   // A depth pre-pass that draw() relies on, if the path has one: drawn first, so that the
   // renderer can draw the background (where depth stays 1) and flush both to llvmpipe's
   // rasterizer threads while draw() shades vertices on this one. False: none drawn.
   virtual bool draw_depth(const Camera&) { return false; }
-  // The per-vertex radiance the vertex stage produces, in GPU vertex order.
-  virtual std::vector<Rgb> capture(const Camera& camera) = 0;
+  // The per-vertex radiance the vertex stage produces, in GPU vertex order. By default: the
+  // program given to shade_whole(), run over every vertex once.
+  virtual std::vector<Rgb> capture(const Camera& camera);
 
   // Shading passes that draw triangles, and whether pass p drew any (an empty pass has no
   // query result).
@@ -53,6 +55,13 @@ class RenderPath {
     if (work_) work_->end();
   }
 
+  // For a path that shades in one draw of `program`, which reads `buffer` at shader storage
+  // binding `binding`: the default draw() and capture() then serve it.
+  void shade_whole(GlProgram* program, GLuint binding, GLuint buffer) {
+    whole_program_ = program;
+    whole_storage_ = {binding, buffer};
+  }
+
   // One draw of the whole mesh with `program` (depth test GL_LESS), counted in queries[0].
   void draw_whole(GlProgram& program, const Camera& camera, const std::vector<GLuint>& queries);
   // Every vertex through `program` once, as points, capturing its radiance.
@@ -61,6 +70,10 @@ class RenderPath {
   std::unique_ptr<GpuMesh> mesh_;
   IndexRange whole_;
   WorkCounter* work_ = nullptr;
+
+ private:
+  GlProgram* whole_program_ = nullptr;
+  std::pair<GLuint, GLuint> whole_storage_{0, 0};  // binding, buffer
 };
 
 struct PathInput {

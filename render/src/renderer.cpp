@@ -26,42 +26,7 @@ double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-constexpr common::EnumName<Mode> kModeNames[] = {{Mode::kMultipass, "multipass"},
-                                                 {Mode::kSinglepass, "singlepass"},
-                                                 {Mode::kDecoupled, "decoupled"},
-                                                 {Mode::kUncompressed, "uncompressed"},
-                                                 {Mode::kCpu, "cpu"}};
-
-constexpr common::EnumName<Accumulation> kAccumulationNames[] = {
-    {Accumulation::kAuto, "auto"},
-    {Accumulation::kFloat32, "rgba32f"},
-    {Accumulation::kFloat16, "rgba16f"}};
-
 }  // namespace
-
-const char* mode_name(Mode mode) {
-  return common::enum_name<Mode>(kModeNames, mode);
-}
-
-Mode parse_mode(const std::string& name) {
-  return common::parse_enum<Mode>(kModeNames, name, "render mode");
-}
-
-std::vector<std::string> mode_names() {
-  return common::enum_names<Mode>(kModeNames);
-}
-
-const char* accumulation_name(Accumulation a) {
-  return common::enum_name<Accumulation>(kAccumulationNames, a);
-}
-
-Accumulation parse_accumulation(const std::string& name) {
-  return common::parse_enum<Accumulation>(kAccumulationNames, name, "accumulation format");
-}
-
-std::vector<std::string> accumulation_names() {
-  return common::enum_names<Accumulation>(kAccumulationNames);
-}
 
 // What every path shares: the SH rotation, the framebuffer, the background and the
 // primitive queries. The path (render_path.h) owns the rest.

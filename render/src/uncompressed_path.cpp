@@ -30,6 +30,7 @@ class UncompressedPath : public RenderPath {
         make_buffer(GL_SHADER_STORAGE_BUFFER,
                     GLsizeiptr(mesh_->vertex_count() * 3 * (glossy ? order * order : 1) * 4),
                     nullptr, GL_DYNAMIC_DRAW);
+    shade_whole(&program_, kExitBinding, exit_buffer_);
     in.stats.registers_per_cluster = 0;
   }
   ~UncompressedPath() override { glDeleteBuffers(1, &exit_buffer_); }
@@ -40,16 +41,6 @@ class UncompressedPath : public RenderPath {
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(exit_.size() * 4), exit_.data());
   }
 
-  void draw(const Camera& camera, const std::vector<GLuint>& queries) override {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kExitBinding, exit_buffer_);
-    draw_whole(program_, camera, queries);
-  }
-
-  std::vector<Rgb> capture(const Camera& camera) override {
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kExitBinding, exit_buffer_);
-    return capture_whole(program_, camera);
-  }
-
  private:
   const prt::TransferSet& transfer_;
   GlProgram program_;
@@ -58,6 +49,18 @@ class UncompressedPath : public RenderPath {
 };
 
 }  // namespace
+
+void RenderPath::draw(const Camera& camera, const std::vector<GLuint>& queries) {
+  if (!whole_program_) throw std::logic_error("a render path without draw() or shade_whole()");
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, whole_storage_.first, whole_storage_.second);
+  draw_whole(*whole_program_, camera, queries);
+}
+
+std::vector<Rgb> RenderPath::capture(const Camera& camera) {
+  if (!whole_program_) throw std::logic_error("a render path without capture() or shade_whole()");
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, whole_storage_.first, whole_storage_.second);
+  return capture_whole(*whole_program_, camera);
+}
 
 void RenderPath::draw_whole(GlProgram& program, const Camera& camera,
                             const std::vector<GLuint>& queries) {

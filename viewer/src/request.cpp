@@ -1,6 +1,5 @@
 #include "viewer/request.h"
 
-#include "common/enum_names.h"
 #include "cpca/supercluster_strategy.h"
 #include "render/pass_capacity.h"
 
@@ -16,11 +15,6 @@
 
 namespace viewer {
 namespace {
-
-constexpr common::EnumName<Overlay> kOverlayNames[] = {{Overlay::kNone, "none"},
-                                                       {Overlay::kOverdraw, "overdraw"},
-                                                       {Overlay::kClusters, "clusters"},
-                                                       {Overlay::kDifference, "difference"}};
 
 // A request value quoted in a reason: bounded and printable, so a reason stays one short line.
 std::string quoted(const std::string& value) {
@@ -78,7 +72,7 @@ void set_client(ViewState& s, const std::string& v, const ViewLimits&) {
 
 void set_mode(ViewState& s, const std::string& v, const ViewLimits& l) {
   try {
-    s.mode = render::parse_mode(v);
+    s.mode = render::kModeNames.parse(v);
   } catch (const std::invalid_argument&) {
     reject("mode", v, "unknown render mode");
   }
@@ -97,9 +91,9 @@ void set_strategy(ViewState& s, const std::string& v, const ViewLimits&) {
 
 void set_overlay(ViewState& s, const std::string& v, const ViewLimits& l) {
   try {
-    s.overlay = common::parse_enum<Overlay>(kOverlayNames, v, "overlay");
+    s.overlay = kOverlayNames.parse(v);
   } catch (const std::invalid_argument&) {
-    reject("overlay", v, "use " + common::enum_name_list<Overlay>(kOverlayNames));
+    reject("overlay", v, "use " + kOverlayNames.list());
   }
   if (s.overlay == Overlay::kDifference && !l.uncompressed)
     reject("overlay", v, "the uncompressed transfer is not at hand");
@@ -140,10 +134,6 @@ const std::vector<std::pair<std::string, Setter>>& setters() {
 }
 
 }  // namespace
-
-const char* overlay_name(Overlay overlay) {
-  return common::enum_name<Overlay>(kOverlayNames, overlay);
-}
 
 namespace {
 

@@ -47,7 +47,7 @@ struct CachedRenderer {
 
 std::string renderer_key(const ViewState& s) {
   const bool grouped = s.mode == render::Mode::kMultipass || s.mode == render::Mode::kDecoupled;
-  return std::string(render::mode_name(s.mode)) + "/" + (grouped ? s.strategy : "-") + "/" +
+  return std::string(render::kModeNames.name(s.mode)) + "/" + (grouped ? s.strategy : "-") + "/" +
          std::to_string(s.register_budget) + "/" + std::to_string(s.clusters_per_pass);
 }
 

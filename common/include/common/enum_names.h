@@ -3,6 +3,8 @@
 // "unknown".
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -47,6 +49,27 @@ E parse_enum(std::span<const EnumName<E>> table, const std::string& name, const 
     if (name == entry.name) return entry.value;
   throw std::invalid_argument("unknown " + std::string(what) + " '" + name + "'; use " +
                               enum_name_list(table));
+}
+
+// An enum's table with the word that names it in messages ("render mode"): each module
+// exposes one per public enum, so printing, parsing and listing share one set of names.
+template <class E, std::size_t N>
+struct EnumTable {
+  const char* what;
+  std::array<EnumName<E>, N> entries;
+
+  const char* name(E value) const { return enum_name<E>(entries, value); }
+  E parse(const std::string& text) const { return parse_enum<E>(entries, text, what); }
+  std::vector<std::string> names() const { return enum_names<E>(entries); }
+  std::string list() const { return enum_name_list<E>(entries); }
+};
+
+// enum_table<Mode>("render mode", {{Mode::kA, "a"}, ...}): the entry count is deduced.
+template <class E, std::size_t N>
+constexpr EnumTable<E, N> enum_table(const char* what, const EnumName<E> (&entries)[N]) {
+  EnumTable<E, N> table{what, {}};
+  for (std::size_t i = 0; i < N; ++i) table.entries[i] = entries[i];
+  return table;
 }
 
 }  // namespace common

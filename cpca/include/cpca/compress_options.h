@@ -32,7 +32,7 @@ struct CompressOptions {
   PcaSolver solver = PcaSolver::kPowerIteration;
   double alpha = 0.0;               // geometry coherence (assignment.h); needs geometry when > 0
   bool overdraw_reduction = false;  // needs geometry
-  OverdrawReductionOptions overdraw;
+  OverdrawReductionOptions overdraw{};
   std::uint64_t seed = 1;
   double lbg_threshold = 1e-3;  // converged ratio (thesis eq. 5)
   int lbg_max_iterations = 200;

@@ -10,6 +10,8 @@
 // below N), and weights the projections of x_p - mean_k onto them.
 #pragma once
 
+#include "common/enum_names.h"
+
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -26,19 +28,19 @@ enum class ClusterMethod : std::uint32_t {
   kJoint = 3,       // local search on error + lambda * overdraw (joint_search.h)
   kPatchJoint = 4,  // the joint search started from patch-first's clusters and passes
 };
-// "lbg", "iterative", "patch-first", "joint", "patch-joint"
-const char* cluster_method_name(ClusterMethod method);
-// Throws std::invalid_argument listing the names.
-ClusterMethod parse_cluster_method(const std::string& name);
-std::vector<std::string> cluster_method_names();
+inline constexpr auto kClusterMethodNames = common::enum_table<ClusterMethod>(
+    "clustering method", {{ClusterMethod::kLbg, "lbg"},
+                          {ClusterMethod::kIterative, "iterative"},
+                          {ClusterMethod::kPatchFirst, "patch-first"},
+                          {ClusterMethod::kJoint, "joint"},
+                          {ClusterMethod::kPatchJoint, "patch-joint"}});
 
 enum class PcaSolver : std::uint32_t {
   kPowerIteration = 0,  // SLF paper Algorithm 1 (default)
   kEigen = 1,           // Eigen's SelfAdjointEigenSolver
 };
-const char* pca_solver_name(PcaSolver solver);  // "power", "eigen"
-PcaSolver parse_pca_solver(const std::string& name);
-std::vector<std::string> pca_solver_names();
+inline constexpr auto kPcaSolverNames = common::enum_table<PcaSolver>(
+    "PCA solver", {{PcaSolver::kPowerIteration, "power"}, {PcaSolver::kEigen, "eigen"}});
 
 struct CompressedSet {
   // Layout of the source transfer (copied from the bake).
@@ -47,7 +49,7 @@ struct CompressedSet {
   int columns = 36;                 // n for glossy transfer matrices, 1 for diffuse vectors
   std::uint64_t mesh_hash = 0;      // meshes::content_hash of the baked mesh
   std::uint64_t transfer_hash = 0;  // FNV-1a of the transfer file's payload (staleness)
-  std::string mesh_path;  // the baked mesh as given to prtr bake, for tools needing geometry
+  std::string mesh_path{};  // the baked mesh as given to prtr bake, for tools needing geometry
 
   // Sizes.
   std::uint64_t vertex_count = 0;
@@ -63,9 +65,9 @@ struct CompressedSet {
   int iterations = 0;  // clustering iterations performed
 
   std::vector<std::uint32_t> cluster_of;  // V
-  std::vector<float> weights;             // V x N, row-major
-  std::vector<float> means;               // K x D, row-major
-  std::vector<float> bases;               // K x N x D: cluster k, component j, then D floats
+  std::vector<float> weights{};           // V x N, row-major
+  std::vector<float> means{};             // K x D, row-major
+  std::vector<float> bases{};             // K x N x D: cluster k, component j, then D floats
 
   int coefficient_count() const { return order * order; }
   std::size_t dimension() const {

@@ -24,6 +24,8 @@
 // local incident lighting l_local. The thesis's fit is B_ij = int_{v.z>0} y_i g_j.
 #pragma once
 
+#include "common/enum_names.h"
+
 #include "prt/view_fit.h"
 
 #include <Eigen/Core>
@@ -51,11 +53,12 @@ struct Material {
   void validate() const;
 };
 
-const char* material_name(MaterialKind kind);  // "lambert", "phong", "cook-torrance"
-// Parses a name as printed by material_name; throws std::invalid_argument listing the names.
-MaterialKind parse_material(const std::string& name);
-const char* masking_name(Masking masking);  // "smith", "v-groove"
-Masking parse_masking(const std::string& name);
+inline constexpr auto kMaterialNames =
+    common::enum_table<MaterialKind>("material", {{MaterialKind::kLambert, "lambert"},
+                                                  {MaterialKind::kPhong, "phong"},
+                                                  {MaterialKind::kCookTorrance, "cook-torrance"}});
+inline constexpr auto kMaskingNames = common::enum_table<Masking>(
+    "masking", {{Masking::kSmith, "smith"}, {Masking::kVGroove, "v-groove"}});
 
 // f_r for one channel (0..2; a grey material ignores it). Local frame, unit vectors.
 double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,

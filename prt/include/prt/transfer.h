@@ -12,6 +12,8 @@
 // index ((p * channels + c) * rows + i) * cols + j with rows = n and cols = 1 or n.
 #pragma once
 
+#include "common/enum_names.h"
+
 #include "prt/material.h"
 
 #include <Eigen/Core>
@@ -23,7 +25,8 @@ namespace prt {
 
 enum class TransferKind { kDiffuse, kGlossy };
 
-const char* transfer_kind_name(TransferKind kind);  // "diffuse", "glossy"
+inline constexpr auto kTransferKindNames = common::enum_table<TransferKind>(
+    "transfer kind", {{TransferKind::kDiffuse, "diffuse"}, {TransferKind::kGlossy, "glossy"}});
 
 struct TransferSet {
   TransferKind kind = TransferKind::kGlossy;

@@ -27,6 +27,8 @@
 // The measurements behind the default are in docs/ARCHITECTURE.md ("The view side").
 #pragma once
 
+#include "common/enum_names.h"
+
 #include <Eigen/Core>
 
 #include <cmath>
@@ -40,9 +42,11 @@ inline constexpr ViewFit kDefaultViewFit = ViewFit::kLeastSquares;
 // lambda of the least-squares fit: the weight of the gradient energy.
 inline constexpr double kViewFitLambda = 1e-3;
 
-const char* view_fit_name(ViewFit fit);  // "hemisphere", "even", "least-squares", "hsh"
-// Parses a name as printed by view_fit_name; throws std::invalid_argument listing the names.
-ViewFit parse_view_fit(const std::string& name);
+inline constexpr auto kViewFitNames =
+    common::enum_table<ViewFit>("view fit", {{ViewFit::kHemisphere, "hemisphere"},
+                                             {ViewFit::kEven, "even"},
+                                             {ViewFit::kLeastSquares, "least-squares"},
+                                             {ViewFit::kHemisphericalHarmonics, "hsh"}});
 // Whether the renderers evaluate this fit's view basis: every fit whose basis is the SH
 // (all but hemispherical harmonics, which only the benchmarks evaluate).
 bool view_fit_renderable(ViewFit fit);

@@ -25,6 +25,8 @@
 // Alpha is coverage. Back faces are culled by default (closed meshes; see the options).
 #pragma once
 
+#include "common/enum_names.h"
+
 #include "cpca/compressed.h"
 #include "cpca/supercluster.h"
 #include "meshes/mesh.h"
@@ -46,10 +48,13 @@
 namespace render {
 
 enum class Mode { kMultipass, kSinglepass, kDecoupled, kUncompressed, kCpu };
-const char* mode_name(Mode mode);  // "multipass", ...; "unknown" out of range
-// Throws std::invalid_argument listing the valid names.
-Mode parse_mode(const std::string& name);
-std::vector<std::string> mode_names();
+// name(mode) gives "unknown" out of range; parse throws std::invalid_argument listing names.
+inline constexpr auto kModeNames =
+    common::enum_table<Mode>("render mode", {{Mode::kMultipass, "multipass"},
+                                             {Mode::kSinglepass, "singlepass"},
+                                             {Mode::kDecoupled, "decoupled"},
+                                             {Mode::kUncompressed, "uncompressed"},
+                                             {Mode::kCpu, "cpu"}});
 
 // The colour target the passes add into. On a GPU, additive blending into RGBA32F runs at a
 // sixth of RGBA16F's rate (0.99 against 6.3 G fragments/s measured on an H200), which bounds
@@ -57,9 +62,10 @@ std::vector<std::string> mode_names();
 // measured in docs/BENCHMARKS.md. On Mesa's software rasterisers the formats cost the same,
 // so kAuto keeps 32-bit floats there and takes half floats on a hardware GPU.
 enum class Accumulation { kAuto, kFloat32, kFloat16 };
-const char* accumulation_name(Accumulation a);             // "auto", "rgba32f", "rgba16f"
-Accumulation parse_accumulation(const std::string& name);  // std::invalid_argument if unknown
-std::vector<std::string> accumulation_names();
+inline constexpr auto kAccumulationNames =
+    common::enum_table<Accumulation>("accumulation format", {{Accumulation::kAuto, "auto"},
+                                                             {Accumulation::kFloat32, "rgba32f"},
+                                                             {Accumulation::kFloat16, "rgba16f"}});
 // What `wanted` means in the current GL context (kAuto resolved by its renderer's name).
 Accumulation resolve_accumulation(Accumulation wanted);
 

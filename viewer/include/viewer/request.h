@@ -6,6 +6,8 @@
 // the list the server scanned at start-up.
 #pragma once
 
+#include "common/enum_names.h"
+
 #include "render/renderer.h"
 
 #include <cstdint>
@@ -17,7 +19,11 @@
 namespace viewer {
 
 enum class Overlay { kNone, kOverdraw, kClusters, kDifference };
-const char* overlay_name(Overlay overlay);
+inline constexpr auto kOverlayNames =
+    common::enum_table<Overlay>("overlay", {{Overlay::kNone, "none"},
+                                            {Overlay::kOverdraw, "overdraw"},
+                                            {Overlay::kClusters, "clusters"},
+                                            {Overlay::kDifference, "difference"}});
 
 struct ViewState {
   std::string client = "default";  // [A-Za-z0-9_-]{1,32}: coalescing key
