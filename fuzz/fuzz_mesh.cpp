@@ -18,10 +18,6 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const auto& path = fuzz_support::write_input(data, size, PRTR_FUZZ_EXTENSION);
-  try {
-    meshes::load_mesh(path);
-  } catch (const std::exception&) {
-  }
-  return 0;
+  return fuzz_support::load_file_input(data, size, PRTR_FUZZ_EXTENSION,
+                                       [](const auto& path) { meshes::load_mesh(path); });
 }

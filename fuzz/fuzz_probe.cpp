@@ -17,10 +17,6 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  const auto& path = fuzz_support::write_input(data, size, PRTR_FUZZ_EXTENSION);
-  try {
-    probes::load_probe(path);
-  } catch (const std::exception&) {
-  }
-  return 0;
+  return fuzz_support::load_file_input(data, size, PRTR_FUZZ_EXTENSION,
+                                       [](const auto& path) { probes::load_probe(path); });
 }

@@ -6,6 +6,7 @@
 // mutations start inside each format rather than at its first check.
 //
 // Usage: make_seeds OUTPUT_DIR BUNNY_OBJ MODELS_DIR PROBES_DIR
+#include "common/base64.h"
 #include "meshes/load.h"
 #include "probes/cube_map.h"
 #include "probes/load.h"
@@ -181,24 +182,10 @@ std::string gltf_bin(const Mesh& m) {
   return bin;
 }
 
-std::string base64(const std::string& bytes) {
-  const char* abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    std::uint32_t n = std::uint32_t(std::uint8_t(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) n |= std::uint32_t(std::uint8_t(bytes[i + 1])) << 8;
-    if (i + 2 < bytes.size()) n |= std::uint32_t(std::uint8_t(bytes[i + 2]));
-    out += abc[(n >> 18) & 63];
-    out += abc[(n >> 12) & 63];
-    out += i + 1 < bytes.size() ? abc[(n >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? abc[n & 63] : '=';
-  }
-  return out;
-}
-
 std::string gltf(const Mesh& m) {
   const std::string bin = gltf_bin(m);
-  return gltf_json(m, bin.size(), "data:application/octet-stream;base64," + base64(bin));
+  return gltf_json(m, bin.size(),
+                   "data:application/octet-stream;base64," + common::base64_encode(bin));
 }
 
 std::string glb(const Mesh& m) {

@@ -14,6 +14,7 @@
 # PRTR_FUZZ_SKIP (targets to leave out, see below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/apt_install.sh
 
 seconds=${1:-60}
 [[ $seconds =~ ^[0-9]+$ && $seconds -gt 0 ]] || { echo "usage: fuzz.sh [SECONDS]" >&2; exit 2; }
@@ -30,14 +31,7 @@ max_len=65536
 if ! command -v clang++ >/dev/null ||
    ! dpkg-query -W -f='${Status}' libclang-rt-14-dev 2>/dev/null | grep -q "install ok installed"; then
   echo "fuzz: installing clang libclang-rt-14-dev" >&2
-  sudo_cmd=()
-  if [[ $(id -u) -ne 0 ]]; then
-    command -v sudo >/dev/null || { echo "fuzz: need root or sudo to install clang" >&2; exit 1; }
-    sudo_cmd=(sudo)
-  fi
-  export DEBIAN_FRONTEND=noninteractive
-  "${sudo_cmd[@]}" apt-get update -qq
-  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends clang libclang-rt-14-dev >/dev/null
+  apt_install fuzz clang libclang-rt-14-dev
 fi
 
 CC=clang CXX=clang++ cmake -S . -B "$dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPRTR_FUZZ=ON \

@@ -16,6 +16,7 @@
 #                                  # test or benchmark packages, and only the prtr target
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source scripts/apt_install.sh
 
 main_only=false
 case ${1:-} in
@@ -55,14 +56,7 @@ done
 
 if ((${#missing[@]})); then
   echo "setup: installing ${missing[*]}" >&2
-  sudo_cmd=()
-  if [[ $(id -u) -ne 0 ]]; then
-    command -v sudo >/dev/null || { echo "setup: need root or sudo to install packages" >&2; exit 1; }
-    sudo_cmd=(sudo)
-  fi
-  export DEBIAN_FRONTEND=noninteractive
-  "${sudo_cmd[@]}" apt-get update -qq
-  "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  apt_install setup "${missing[@]}"
   echo "setup: installed ${#missing[@]} packages in $SECONDS s" >&2
 else
   echo "setup: all ${#packages[@]} packages present" >&2

@@ -1,4 +1,5 @@
 #include "common/atomic_file.h"
+#include "common/base64.h"
 #include "common/check.h"
 #include "common/enum_names.h"
 #include "common/hash.h"
@@ -177,4 +178,23 @@ TEST(WorkQueue, FirstFailureReachesTheProducer) {
   }
   EXPECT_THROW(queue.submit([] {}), std::runtime_error);
   EXPECT_THROW(common::WorkQueue(0, 1), std::invalid_argument);
+}
+
+// RFC 4648's test vectors, and a round trip of every byte value at every padding length.
+TEST(Base64, MatchesTheRfcVectorsAndRoundTrips) {
+  const std::pair<const char*, const char*> vectors[] = {{"", ""},
+                                                         {"f", "Zg=="},
+                                                         {"fo", "Zm8="},
+                                                         {"foo", "Zm9v"},
+                                                         {"foob", "Zm9vYg=="},
+                                                         {"fooba", "Zm9vYmE="},
+                                                         {"foobar", "Zm9vYmFy"}};
+  for (const auto& [plain, coded] : vectors) {
+    EXPECT_EQ(common::base64_encode(plain), coded);
+    EXPECT_EQ(common::base64_decode(coded), plain);
+  }
+  std::string bytes;
+  for (int i = 0; i < 256; ++i) bytes += char(i);
+  for (std::size_t n = 253; n <= 256; ++n)
+    EXPECT_EQ(common::base64_decode(common::base64_encode(bytes.substr(0, n))), bytes.substr(0, n));
 }

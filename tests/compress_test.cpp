@@ -130,13 +130,14 @@ TEST(Compress, IterativeCpcaNeverLosesToLbgPlusPca) {
               iterative.error.average_squared_error, 1e-4 * iterative.error.average_squared_error);
 }
 
+// Options for 16-float points read as order-4 grey diffuse vectors (n = 16).
+cpca::CompressOptions order4_options(int clusters, int components) {
+  return {.layout = {4, 1, 1}, .clusters = clusters, .components = components};
+}
+
 TEST(SubspaceDistances, MatchReconstructionOfEveryPointInEveryCluster) {
   const cpca::DataMatrix x = affine_subspaces(3, 40, 4, 16, 7);
-  cpca::CompressOptions o;
-  o.layout = {4, 1, 1};
-  o.clusters = 4;
-  o.components = 2;
-  const cpca::CompressedSet set = cpca::compress(x, o);
+  const cpca::CompressedSet set = cpca::compress(x, order4_options(4, 2));
   const cpca::DataMatrix d = cpca::subspace_distances(x, x.rowwise().squaredNorm(), set);
   for (int p = 0; p < x.rows(); ++p)
     for (int k = 0; k < 4; ++k) {
@@ -174,10 +175,7 @@ TEST(OverdrawReduction, FewerStraddlingTrianglesWithinTheErrorBudget) {
     for (int j = 0; j < 16; ++j)
       x(i, j) = std::sin(3.f * p.x() * float(j + 1)) + std::cos(2.f * p.y() * float(j)) + n(rng);
   }
-  cpca::CompressOptions o;
-  o.layout = {4, 1, 1};
-  o.clusters = 16;
-  o.components = 3;
+  cpca::CompressOptions o = order4_options(16, 3);
   cpca::CompressReport before, after;
   cpca::compress(x, o, &g, &before);
   o.overdraw_reduction = true;
@@ -257,11 +255,7 @@ namespace {
 
 TEST(SubspaceDistances, CandidateRestrictionAgreesWithTheFullMatrix) {
   const cpca::DataMatrix x = affine_subspaces(6, 30, 3, 16, 9);
-  cpca::CompressOptions o;
-  o.layout = {4, 1, 1};
-  o.clusters = 6;
-  o.components = 2;
-  const cpca::CompressedSet set = cpca::compress(x, o);
+  const cpca::CompressedSet set = cpca::compress(x, order4_options(6, 2));
   const Eigen::VectorXf norms = x.rowwise().squaredNorm();
   const cpca::DataMatrix full = cpca::subspace_distances(x, norms, set);
   const cpca::DataMatrix some = cpca::subspace_distances(x, norms, set, 2);

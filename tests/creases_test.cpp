@@ -20,9 +20,7 @@ using meshes::Mesh;
 using meshes::Vec3;
 
 fs::path write_file(const std::string& name, const std::string& content) {
-  const fs::path p = test_support::scratch("creases", name);
-  std::ofstream(p, std::ios::binary) << content;
-  return p;
+  return test_support::write_scratch("creases", name, content);
 }
 
 // Blender's auto-smooth angle: the cube's 90-degree edges are hard, a sphere's are not.

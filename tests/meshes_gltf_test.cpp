@@ -2,6 +2,7 @@
 // the guards in front of Assimp. Every file is written here; world positions are checked
 // against the node transforms composed by the glTF rule (T * R * S, parent * child) with
 // Eigen, independently of Assimp.
+#include "common/base64.h"
 #include "meshes/load.h"
 #include "meshes/weld.h"
 #include "test_support.h"
@@ -22,24 +23,7 @@ using meshes::Vec3;
 using nlohmann::json;
 
 fs::path write_file(const std::string& name, const std::string& content) {
-  const fs::path p = test_support::scratch("meshes_gltf", name);
-  std::ofstream(p, std::ios::binary) << content;
-  return p;
-}
-
-std::string base64(const std::string& bytes) {
-  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    std::uint32_t n = std::uint32_t(std::uint8_t(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) n |= std::uint32_t(std::uint8_t(bytes[i + 1])) << 8;
-    if (i + 2 < bytes.size()) n |= std::uint32_t(std::uint8_t(bytes[i + 2]));
-    out += kAlphabet[(n >> 18) & 63];
-    out += kAlphabet[(n >> 12) & 63];
-    out += i + 1 < bytes.size() ? kAlphabet[(n >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? kAlphabet[n & 63] : '=';
-  }
-  return out;
+  return test_support::write_scratch("meshes_gltf", name, content);
 }
 
 template <class T>
@@ -102,7 +86,8 @@ Scene two_mesh_scene() {
 }
 
 std::string as_gltf(Scene s) {
-  s.gltf["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(s.bin);
+  s.gltf["buffers"][0]["uri"] =
+      "data:application/octet-stream;base64," + common::base64_encode(s.bin);
   return s.gltf.dump();
 }
 
@@ -248,7 +233,7 @@ TEST(GltfErrors, DataUrisMustBeBase64) {
   std::string long_header = "data:application";
   long_header.append(110, 'x');
   long_header += "/octet-stream;base64,";
-  long_header += base64(h.bin);
+  long_header += common::base64_encode(h.bin);
   h.gltf["buffers"][0]["uri"] = long_header;
   expect_load_error(write_file("long_header.gltf", h.gltf.dump()), "header of 146 characters");
 }

@@ -6,6 +6,7 @@
 #include "meshes/mesh.h"
 #include "meshes/procedural.h"
 #include "meshes/spatial_order.h"
+#include "test_support.h"
 
 #include <gtest/gtest.h>
 
@@ -119,13 +120,7 @@ std::set<std::pair<std::uint32_t, std::uint32_t>> directed_edges(const Mesh& m, 
 // The message of the MeshError `f` throws; a test failure if it throws nothing.
 template <class F>
 std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const MeshError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected a MeshError";
-  return {};
+  return test_support::message_of<MeshError>(f);
 }
 
 bool contains(const std::string& text, const std::string& part) {

@@ -4,6 +4,7 @@
 #include "probes/load.h"
 #include "probes/probe.h"
 #include "probes/procedural.h"
+#include "test_support.h"
 
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
@@ -53,13 +54,7 @@ void write_image(const fs::path& path, int w, int h, int channels, const std::ve
 
 // The message of the ProbeError `f` throws ("" and a test failure if it throws none).
 std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const ProbeError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "no ProbeError thrown";
-  return {};
+  return test_support::message_of<ProbeError>(f);
 }
 
 Eigen::Vector3d random_direction(std::mt19937& rng) {
@@ -431,12 +426,18 @@ TEST(ProbeClass, ValidatesItsInput) {
 
 // --- Loading ---------------------------------------------------------------------------------
 
+// w x h RGB texels drawn uniformly from [lo, hi).
+std::vector<float> random_texels(int w, int h, unsigned seed, float lo, float hi) {
+  std::vector<float> data(std::size_t(w) * h * 3);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> value(lo, hi);
+  for (float& x : data) x = value(rng);
+  return data;
+}
+
 TEST(Load, ExrRoundTrip) {
   const int w = 40, h = 20;
-  std::vector<float> data(std::size_t(w) * h * 3);
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<float> value(0.0f, 50000.0f);
-  for (float& x : data) x = value(rng);
+  const std::vector<float> data = random_texels(w, h, 4, 0.0f, 50000.0f);
   const fs::path path = tmp_dir() / "roundtrip.exr";
   write_image(path, w, h, 3, data);
   LoadReport report;
@@ -463,10 +464,7 @@ TEST(Load, HdrRoundTrip) {
   // Radiance RGBE: 8-bit mantissas with a shared exponent, truncated; each channel errs by
   // less than 2^-7 of the texel's largest channel (measured ~0.4%). Tolerance 1%.
   const int w = 32, h = 16;
-  std::vector<float> data(std::size_t(w) * h * 3);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<float> value(0.01f, 30000.0f);
-  for (float& x : data) x = value(rng);
+  const std::vector<float> data = random_texels(w, h, 5, 0.01f, 30000.0f);
   const fs::path path = tmp_dir() / "roundtrip.hdr";
   write_image(path, w, h, 3, data);
   LoadReport report;

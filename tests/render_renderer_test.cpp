@@ -208,7 +208,7 @@ TEST_P(CaptureTest, EveryModeMatchesTheCpuReference) {
       render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
       const auto captured = r.capture_vertex_radiance(s.camera, s.lighting, R);
       EXPECT_LT(max_relative_error(captured, reference), kVertexTolerance)
-          << render::mode_name(mode) << (feedback ? "" : ", in-draw shading");
+          << render::kModeNames.name(mode) << (feedback ? "" : ", in-draw shading");
     }
 }
 
@@ -218,8 +218,8 @@ INSTANTIATE_TEST_SUITE_P(Orders, CaptureTest,
                                            CaptureCase{6, prt::TransferKind::kGlossy, true},
                                            CaptureCase{4, prt::TransferKind::kDiffuse, false}),
                          [](const ::testing::TestParamInfo<CaptureCase>& p) {
-                           return std::string(prt::transfer_kind_name(p.param.kind)) + "_order" +
-                                  std::to_string(p.param.order) +
+                           return std::string(prt::kTransferKindNames.name(p.param.kind)) +
+                                  "_order" + std::to_string(p.param.order) +
                                   (p.param.coloured ? "_rgb" : "_grey");
                          });
 
@@ -285,7 +285,8 @@ TEST(ShaderSource, CompiledShadersMatchTheCpuReferenceAtOrders1To10) {
         render::Renderer r(mesh, &set, nullptr, nullptr, options(mode));
         EXPECT_LT(max_relative_error(r.capture_vertex_radiance(camera, lighting, R), reference),
                   kVertexTolerance)
-            << "order " << order << (glossy ? " glossy " : " diffuse ") << render::mode_name(mode);
+            << "order " << order << (glossy ? " glossy " : " diffuse ")
+            << render::kModeNames.name(mode);
       }
     }
   }
@@ -414,10 +415,11 @@ TEST(Renderer, DecoupledCpuAndSinglepassImagesAgree) {
     o.count_primitives = true;
     const render::Image other = render_once(ctx, s, o, s.camera, R, &stats);
     EXPECT_LT(max_abs_difference(other, single), image_tolerance(5, 4) * scale)
-        << render::mode_name(mode);
+        << render::kModeNames.name(mode);
     // Overdraw 1 means GL drew every triangle exactly once, whatever the stats say.
-    ASSERT_EQ(stats.measured_triangles.size(), 1u) << render::mode_name(mode);
-    EXPECT_EQ(stats.measured_triangles[0], s.mesh.triangle_count()) << render::mode_name(mode);
+    ASSERT_EQ(stats.measured_triangles.size(), 1u) << render::kModeNames.name(mode);
+    EXPECT_EQ(stats.measured_triangles[0], s.mesh.triangle_count())
+        << render::kModeNames.name(mode);
   }
 }
 
@@ -494,27 +496,28 @@ TEST(Renderer, RotatingProbeAndCameraTogetherLeavesTheSphereUnchanged) {
 
 // --- Background ------------------------------------------------------------------------------
 
-// The background's filter: the cubic B-spline of the probe's texels at the lat-long point of
-// direction d (wrapping in u, clamping in v, texel centres at half-integers).
+// The uniform cubic B-spline kernel, in its closed form by distance: an oracle written apart
+// from the renderer's separable weights.
+double cubic_bspline(double t) {
+  t = std::abs(t);
+  if (t < 1) return 2.0 / 3.0 - t * t + t * t * t / 2;
+  return t < 2 ? (2 - t) * (2 - t) * (2 - t) / 6 : 0.0;
+}
+
+// The background's filter: the probe's texels, weighted by the kernel of their distance from
+// the lat-long point of direction d (texel centres at half-integers, wrapping in u, clamping
+// in v).
 probes::Rgb bspline_lookup(const probes::Probe& probe, const Eigen::Vector3d& d) {
-  const double theta = std::acos(std::clamp(d.y(), -1.0, 1.0));
-  double phi = std::atan2(-d.x(), d.z());
-  if (phi < 0) phi += 2 * std::numbers::pi;
-  const double px = phi / (2 * std::numbers::pi) * probe.width() - 0.5;
-  const double py = theta / std::numbers::pi * probe.height() - 0.5;
-  const double ix = std::floor(px), iy = std::floor(py);
-  auto weights = [](double f) {
-    return std::array<double, 4>{(1 - f) * (1 - f) * (1 - f) / 6,
-                                 (3 * f * f * f - 6 * f * f + 4) / 6,
-                                 (-3 * f * f * f + 3 * f * f + 3 * f + 1) / 6, f * f * f / 6};
-  };
-  const auto wx = weights(px - ix), wy = weights(py - iy);
+  const double u = std::atan2(-d.x(), d.z()) / (2 * std::numbers::pi);
+  const double px = (u < 0 ? u + 1 : u) * probe.width() - 0.5;
+  const double py =
+      std::acos(std::clamp(d.y(), -1.0, 1.0)) / std::numbers::pi * probe.height() - 0.5;
   probes::Rgb sum = probes::Rgb::Zero();
-  for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) {
-      const int x = ((int(ix) - 1 + i) % probe.width() + probe.width()) % probe.width();
-      const int y = std::clamp(int(iy) - 1 + j, 0, probe.height() - 1);
-      sum += float(wx[i] * wy[j]) * probe.texel(x, y);
+  for (int y = int(std::floor(py)) - 1; y <= int(std::floor(py)) + 2; ++y)
+    for (int x = int(std::floor(px)) - 1; x <= int(std::floor(px)) + 2; ++x) {
+      const int wrapped = (x % probe.width() + probe.width()) % probe.width();
+      sum += float(cubic_bspline(px - x) * cubic_bspline(py - y)) *
+             probe.texel(wrapped, std::clamp(y, 0, probe.height() - 1));
     }
   return sum;
 }
@@ -690,7 +693,7 @@ TEST(Renderer, RejectsBudgetsBelowOneCluster) {
   EXPECT_THROW(
       render::Renderer(s.mesh, nullptr, nullptr, nullptr, options(render::Mode::kUncompressed)),
       std::invalid_argument);
-  EXPECT_THROW(render::parse_mode("fast"), std::invalid_argument);
+  EXPECT_THROW(render::kModeNames.parse("fast"), std::invalid_argument);
 }
 
 // --- Backends -------------------------------------------------------------------------------
@@ -741,7 +744,7 @@ TEST(Renderer, WorkCountersMatchTheDrawsTheyBracket) {
     render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
     r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());
     const render::RenderStats& st = r.stats();
-    ASSERT_FALSE(st.pass_work.empty()) << render::mode_name(mode);
+    ASSERT_FALSE(st.pass_work.empty()) << render::kModeNames.name(mode);
     std::uint64_t shaded_triangles = 0;
     for (const render::PassWork& p : st.pass_work) {
       if (p.label == "background") {
@@ -749,7 +752,8 @@ TEST(Renderer, WorkCountersMatchTheDrawsTheyBracket) {
         EXPECT_GT(p.fs_invocations, 0u);
         continue;
       }
-      EXPECT_GE(p.vs_invocations, p.referenced_vertices) << render::mode_name(mode) << p.label;
+      EXPECT_GE(p.vs_invocations, p.referenced_vertices)
+          << render::kModeNames.name(mode) << p.label;
       if (p.label == "feedback") {
         EXPECT_EQ(p.vs_invocations, s.mesh.vertex_count());
         EXPECT_EQ(p.primitives, s.mesh.vertex_count());
@@ -762,7 +766,7 @@ TEST(Renderer, WorkCountersMatchTheDrawsTheyBracket) {
     }
     std::uint64_t predicted = 0;
     for (std::uint64_t t : st.triangles_per_pass) predicted += t;
-    EXPECT_EQ(shaded_triangles, predicted) << render::mode_name(mode);
+    EXPECT_EQ(shaded_triangles, predicted) << render::kModeNames.name(mode);
     const render::WorkTotals totals = render::work_totals(st.pass_work);
     EXPECT_GE(totals.vs_per_referenced_vertex, 1.0);
   }
@@ -794,6 +798,6 @@ TEST(Renderer, EveryModeRunsWithoutDebugErrors) {
     r.render(s.camera, s.lighting, test_rotation());
     r.capture_vertex_radiance(s.camera, s.lighting, test_rotation());
     for (const std::string& m : log.messages())
-      ADD_FAILURE() << render::mode_name(mode) << ": " << m;
+      ADD_FAILURE() << render::kModeNames.name(mode) << ": " << m;
   }
 }

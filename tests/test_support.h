@@ -20,6 +20,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 #include <sys/resource.h>
@@ -58,6 +59,26 @@ inline std::filesystem::path scratch(const std::string& suite, const std::string
   const std::filesystem::path dir = std::filesystem::path(PRTR_TEST_TMPDIR) / suite;
   std::filesystem::create_directories(dir);
   return dir / name;
+}
+
+// Writes `content` (bytes as they are) to `name` in `suite`'s scratch directory.
+inline std::filesystem::path write_scratch(const std::string& suite, const std::string& name,
+                                           const std::string& content) {
+  const std::filesystem::path p = scratch(suite, name);
+  std::ofstream(p, std::ios::binary) << content;
+  return p;
+}
+
+// The message of the `Error` that `f()` throws; a test failure (and "") when it throws none.
+template <class Error, class F>
+std::string message_of(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected a " << typeid(Error).name();
+  return {};
 }
 
 inline std::string slurp(const std::filesystem::path& p) {

@@ -125,8 +125,8 @@ std::string read_error(const fs::path& p, const std::string& expected) {
 // --- Round trips ---------------------------------------------------------------------------
 
 TEST(TransferFile, KindNames) {
-  EXPECT_STREQ(prt::transfer_kind_name(TransferKind::kDiffuse), "diffuse");
-  EXPECT_STREQ(prt::transfer_kind_name(TransferKind::kGlossy), "glossy");
+  EXPECT_STREQ(prt::kTransferKindNames.name(TransferKind::kDiffuse), "diffuse");
+  EXPECT_STREQ(prt::kTransferKindNames.name(TransferKind::kGlossy), "glossy");
 }
 
 TEST(TransferFile, RoundTripIsExact) {
@@ -489,34 +489,32 @@ TEST(TransferFile, EachCorruptionHasItsOwnMessage) {
     patch<std::uint8_t>(p, kPayloadOffset + 17, std::uint8_t(bytes[kPayloadOffset + 17] ^ 0x10));
     check("payload checksum", p, "payload damaged");
   }
+  // Both checksums recomputed after a payload patch, so that only the value checks can object.
+  const auto reseal_payload = [&](const fs::path& p) {
+    const std::string bytes = slurp(p);
+    patch<std::uint64_t>(p, kOffPayloadChecksum,
+                         common::fnv1a(bytes.data() + kPayloadOffset, payload_bytes));
+    reseal_header(p);
+  };
   {
     // A NaN with both checksums recomputed: only the finite check can catch it. Float 22 of a
     // 3-channel order-2 glossy set (48 floats per vertex, 16 per channel) is vertex 0,
     // channel 1, entry (1, 2).
     const fs::path p = fresh("nan");
     patch<float>(p, kPayloadOffset + 4 * 22, std::numeric_limits<float>::quiet_NaN());
-    const std::string bytes = slurp(p);
-    patch<std::uint64_t>(p, kOffPayloadChecksum,
-                         common::fnv1a(bytes.data() + kPayloadOffset, payload_bytes));
-    reseal_header(p);
+    reseal_payload(p);
     check("nan", p, "non-finite value nan at vertex 0, channel 1, entry (1, 2)");
   }
   {
     const fs::path p = fresh("inf");
     patch<float>(p, kPayloadOffset + 4 * (48 * 3 + 5), std::numeric_limits<float>::infinity());
-    const std::string bytes = slurp(p);
-    patch<std::uint64_t>(p, kOffPayloadChecksum,
-                         common::fnv1a(bytes.data() + kPayloadOffset, payload_bytes));
-    reseal_header(p);
+    reseal_payload(p);
     check("inf", p, "non-finite value inf at vertex 3, channel 0, entry (1, 1)");
   }
   {
     const fs::path p = fresh("huge");
     patch<float>(p, kPayloadOffset + 4 * 7, -3e38f);
-    const std::string bytes = slurp(p);
-    patch<std::uint64_t>(p, kOffPayloadChecksum,
-                         common::fnv1a(bytes.data() + kPayloadOffset, payload_bytes));
-    reseal_header(p);
+    reseal_payload(p);
     check("huge", p, "value beyond +-1e12 -3");
   }
   {

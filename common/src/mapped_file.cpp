@@ -60,14 +60,19 @@ void MappedFile::release(std::size_t offset, std::size_t bytes) const {
   ::madvise(const_cast<unsigned char*>(data_) + begin, end - begin, MADV_DONTNEED);
 }
 
-void read_exact(int fd, void* out, std::size_t bytes, std::uint64_t offset, const char* what) {
-  auto* p = static_cast<unsigned char*>(out);
+namespace {
+
+// pread or pwrite until all `bytes` moved, retrying short transfers and EINTR; a transfer of
+// nothing is `at_zero` ("unexpected end of file", "disk full?").
+template <class Byte, class Io>
+void transfer_exact(Io io, int fd, Byte* p, std::size_t bytes, std::uint64_t offset,
+                    const char* what, const char* verb, const char* at_zero) {
   while (bytes > 0) {
-    const ssize_t n = ::pread(fd, p, bytes, static_cast<off_t>(offset));
+    const ssize_t n = io(fd, p, bytes, static_cast<off_t>(offset));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      throw IoError(std::string(what) + ": read failed (" +
-                    (n == 0 ? std::string("unexpected end of file") : std::strerror(errno)) + ")");
+      throw IoError(std::string(what) + ": " + verb + " failed (" +
+                    (n == 0 ? std::string(at_zero) : std::strerror(errno)) + ")");
     }
     p += n;
     bytes -= static_cast<std::size_t>(n);
@@ -75,20 +80,17 @@ void read_exact(int fd, void* out, std::size_t bytes, std::uint64_t offset, cons
   }
 }
 
+}  // namespace
+
+void read_exact(int fd, void* out, std::size_t bytes, std::uint64_t offset, const char* what) {
+  transfer_exact(::pread, fd, static_cast<unsigned char*>(out), bytes, offset, what, "read",
+                 "unexpected end of file");
+}
+
 void write_exact(int fd, const void* data, std::size_t bytes, std::uint64_t offset,
                  const char* what) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  while (bytes > 0) {
-    const ssize_t n = ::pwrite(fd, p, bytes, static_cast<off_t>(offset));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      throw IoError(std::string(what) + ": write failed (" +
-                    (n == 0 ? std::string("disk full?") : std::strerror(errno)) + ")");
-    }
-    p += n;
-    bytes -= static_cast<std::size_t>(n);
-    offset += static_cast<std::uint64_t>(n);
-  }
+  transfer_exact(::pwrite, fd, static_cast<const unsigned char*>(data), bytes, offset, what,
+                 "write", "disk full?");
 }
 
 }  // namespace common

@@ -1,10 +1,13 @@
-// meshes/asset_guard.cpp: the checks in front of Assimp (see asset_guard.h).
+// meshes/asset_guard.cpp: the glTF and GLB checks in front of Assimp (see asset_guard.h; the
+// 3DS check is asset_guard_3ds.cpp).
 //
-// Every check reports by throwing Refusal inside this file; the entry points turn it into
+// Every check reports by throwing Refusal (guard_refusal.h); the entry points turn it into
 // the returned string. Sizes are compared in 64 bits after bounding each factor, so no
 // claimed count can overflow a comparison.
 #include "asset_guard.h"
+#include "guard_refusal.h"
 
+#include "common/base64.h"
 #include "common/input_file.h"
 
 #include <nlohmann/json.hpp>
@@ -24,30 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-struct Refusal {
-  std::string problem;
-};
-
-[[noreturn]] void refuse(const std::string& problem) {
-  throw Refusal{problem};
-}
-
-std::string read_all(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
-std::uint32_t le32(std::string_view b, std::size_t at) {
-  const auto* p = reinterpret_cast<const unsigned char*>(b.data() + at);
-  return std::uint32_t(p[0]) | (std::uint32_t(p[1]) << 8) | (std::uint32_t(p[2]) << 16) |
-         (std::uint32_t(p[3]) << 24);
-}
-
-std::uint16_t le16(std::string_view b, std::size_t at) {
-  const auto* p = reinterpret_cast<const unsigned char*>(b.data() + at);
-  return std::uint16_t(p[0] | (p[1] << 8));
-}
 
 // --- glTF JSON ------------------------------------------------------------------------------
 
@@ -446,7 +425,10 @@ class BufferBytes {
     const BufferSource& source = sources_[b];
     if (source.glb_chunk) return glb_bin_;
     std::optional<std::string>& bytes = owned_[b];
-    if (!bytes) bytes = source.file.empty() ? base64_payload(source.data_uri) : file_bytes(source);
+    if (!bytes)
+      bytes = source.file.empty()
+                  ? common::base64_decode(source.data_uri.substr(source.data_uri.find(',') + 1))
+                  : file_bytes(source);
     // A file that shrank since it was measured is as damaged as a short one.
     if (bytes->size() < source.length) {
       refuse("buffer " + std::to_string(b) + " holds " + std::to_string(bytes->size()) +
@@ -457,32 +439,6 @@ class BufferBytes {
   }
 
  private:
-  static std::string base64_payload(std::string_view uri) {
-    const auto value = [](char c) -> std::uint32_t {
-      if (c >= 'A' && c <= 'Z') return std::uint32_t(c - 'A');
-      if (c >= 'a' && c <= 'z') return std::uint32_t(c - 'a' + 26);
-      if (c >= '0' && c <= '9') return std::uint32_t(c - '0' + 52);
-      return c == '+' ? 62u : 63u;  // '/'; characters were checked by data_uri_bytes
-    };
-    const std::string_view payload = uri.substr(uri.find(',') + 1);
-    std::string out;
-    out.reserve(payload.size() / 4 * 3);
-    for (std::size_t i = 0; i + 4 <= payload.size(); i += 4) {
-      std::uint32_t quad = 0;
-      int bytes = 3;
-      for (std::size_t k = 0; k < 4; ++k) {
-        if (payload[i + k] == '=') {
-          --bytes;
-          quad <<= 6;
-        } else {
-          quad = (quad << 6) | value(payload[i + k]);
-        }
-      }
-      for (int k = 0; k < bytes; ++k) out += char((quad >> (16 - 8 * k)) & 0xFF);
-    }
-    return out;
-  }
-
   static std::string file_bytes(const BufferSource& source) {
     common::InputFile in = common::open_input_file(source.file, kMaxAssetBytes);
     if (in.file == nullptr) refuse("its buffer file " + source.file.string() + " " + in.problem);
@@ -681,153 +637,6 @@ void check_glb_bytes(std::string_view b, const fs::path& folder, ReferencedFiles
   check_gltf_json(*json_chunk, folder, bin, referenced);
 }
 
-// --- 3DS ------------------------------------------------------------------------------------
-
-// Chunks whose body is a list of chunks (0x4000 after its name). Every chunk's claimed length
-// is checked against its parent's end, iteratively, before Assimp's own walk.
-// The keyframer (0xB000) holds node tags 0xB001..0xB007, which hold tracks.
-bool is_3ds_container(std::uint16_t id) {
-  return id == 0x4D4D || id == 0x3D3D || id == 0x4000 || id == 0x4100 || id == 0xAFFF ||
-         (id >= 0xB000 && id <= 0xB007);
-}
-
-// Keyframe tracks (0xB020 position ... 0xB029 hide): a 10-byte header, a 32-bit key count,
-// then keys of at least 6 bytes (frame and flags). Assimp reserves the count times 24 bytes
-// before reading a key, so a 150-byte file could ask for 51 GB; the count must fit the chunk.
-void check_3ds_track(std::string_view b, std::size_t at, std::uint64_t length) {
-  constexpr std::uint64_t kHeader = 6 + 10 + 4;
-  constexpr std::uint64_t kSmallestKey = 6;
-  const std::uint64_t keys = length >= kHeader ? le32(b, at + 16) : 0;
-  if (length < kHeader || keys > (length - kHeader) / kSmallestKey) {
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "%04x", le16(b, at));
-    refuse("keyframe track 0x" + std::string(hex) + " at byte " + std::to_string(at) + " claims " +
-           std::to_string(keys) + " keys in " + std::to_string(length) +
-           " bytes; the file is damaged");
-  }
-}
-
-// Vertex (0x4110, 12 bytes each), face (0x4120, 8) and texture coordinate (0x4140, 8) lists:
-// a 16-bit count, then the records. Assimp would stop at the chunk's end with a message that
-// names nothing; this one says which list is short.
-void check_3ds_list(std::string_view b, std::size_t at, std::uint64_t length) {
-  const std::uint16_t id = le16(b, at);
-  const std::uint64_t record = id == 0x4110 ? 12 : 8;
-  const std::uint64_t count = length >= 8 ? le16(b, at + 6) : 0;
-  if (length < 8 || 8 + count * record > length) {
-    const char* what = id == 0x4110 ? "vertex" : id == 0x4120 ? "face" : "texture coordinate";
-    refuse(std::string(what) + " list chunk at byte " + std::to_string(at) + " claims " +
-           std::to_string(count) + " records of " + std::to_string(record) + " bytes in " +
-           std::to_string(length) + " bytes; the file is damaged");
-  }
-}
-
-// The vertices of the triangle mesh chunk (0x4100) at `at`: the sum of its vertex lists
-// (Assimp appends them). Malformed children are left to the walk, which refuses them.
-std::uint64_t trimesh_vertices(std::string_view b, std::size_t at, std::uint64_t length) {
-  std::uint64_t vertices = 0;
-  for (std::size_t child = at + 6; child + 8 <= at + length;) {
-    const std::uint64_t child_length = le32(b, child + 2);
-    if (child_length < 6 || child_length > at + length - child) break;
-    if (le16(b, child) == 0x4110) vertices += le16(b, child + 6);
-    child += child_length;
-  }
-  return vertices;
-}
-
-// Every face of a face list (0x4120, after check_3ds_list) must name a vertex of its mesh:
-// Assimp replaces an index out of range by the last vertex, which keeps a wrong triangle.
-void check_3ds_faces(std::string_view b, std::size_t at, std::uint64_t vertices) {
-  const std::uint64_t faces = le16(b, at + 6);
-  for (std::uint64_t f = 0; f < faces; ++f) {
-    for (std::size_t c = 0; c < 3; ++c) {
-      const std::uint64_t index = le16(b, at + 8 + 8 * f + 2 * c);
-      if (index >= vertices) {
-        refuse("face " + std::to_string(f) + " of the face list at byte " + std::to_string(at) +
-               " names vertex " + std::to_string(index) + ", but its mesh has " +
-               std::to_string(vertices) + " vertices; the file is damaged");
-      }
-    }
-  }
-}
-
-void check_3ds_bytes(std::string_view b) {
-  if (b.size() < 6 || le16(b, 0) != 0x4D4D) {
-    refuse("it does not start with a 3DS main chunk (0x4d4d); it is not a 3DS file");
-  }
-  if (le32(b, 2) < 6 || le32(b, 2) > b.size()) {
-    refuse("chunk 0x4d4d at byte 0 claims " + std::to_string(le32(b, 2)) +
-           " bytes, but the file has " + std::to_string(b.size()) + "; the file is damaged");
-  }
-  // The ends of the chunks enclosing `at`, innermost last.
-  std::vector<std::size_t> open{le32(b, 2)};
-  std::size_t at = 6;
-  std::uint64_t mesh_vertices = 0;  // of the innermost triangle mesh chunk
-  bool any_mesh = false;
-  while (!open.empty()) {
-    const std::size_t end = open.back();
-    if (at >= end) {
-      at = end;
-      open.pop_back();
-      continue;
-    }
-    if (end - at < 6)
-      refuse("a chunk header at byte " + std::to_string(at) +
-             " is cut off; "
-             "the file is damaged");
-    const std::uint16_t id = le16(b, at);
-    const std::uint64_t length = le32(b, at + 2);
-    if (length < 6 || length > end - at) {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "%04x", id);
-      refuse("chunk 0x" + std::string(hex) + " at byte " + std::to_string(at) + " claims " +
-             std::to_string(length) + " bytes, past its parent's end; the file is damaged");
-    }
-    if (id >= 0xB020 && id <= 0xB029) check_3ds_track(b, at, length);
-    if (id == 0x4110 || id == 0x4120 || id == 0x4140) check_3ds_list(b, at, length);
-    if (id == 0x4100) {
-      mesh_vertices = trimesh_vertices(b, at, length);
-      any_mesh = true;
-    }
-    if (id == 0x4120) check_3ds_faces(b, at, mesh_vertices);
-    if (!is_3ds_container(id)) {
-      at += length;
-      continue;
-    }
-    if (open.size() > std::size_t(kMax3dsDepth)) {
-      refuse("its chunks nest deeper than " + std::to_string(kMax3dsDepth) +
-             " levels; no 3DS file needs that, the file is damaged");
-    }
-    std::size_t body = at + 6;
-    if (id == 0x4000) {  // a zero-terminated object name comes first
-      while (body < at + length && b[body] != '\0') ++body;
-      ++body;
-    }
-    open.push_back(std::size_t(at + length));
-    at = body;
-  }
-  // Assimp would refuse it too, but leaks what it read first (a light: 1,132 bytes).
-  if (!any_mesh) {
-    refuse(
-        "it holds no triangle mesh (no 0x4100 chunk; only lights, cameras or materials); "
-        "export the geometry");
-  }
-}
-
-template <class Check>
-std::string guarded(std::uint64_t size, const Check& check) {
-  if (size > kMaxAssetBytes) {
-    return "the file has " + std::to_string(size) + " bytes, over the " +
-           std::to_string(kMaxAssetBytes >> 20) + " MiB limit for glTF and 3DS assets";
-  }
-  try {
-    check();
-  } catch (const Refusal& r) {
-    return r.problem;
-  }
-  return {};
-}
-
 }  // namespace
 
 std::string check_gltf(const fs::path& path, std::uint64_t size, ReferencedFiles& referenced) {
@@ -837,10 +646,6 @@ std::string check_gltf(const fs::path& path, std::uint64_t size, ReferencedFiles
 
 std::string check_glb(const fs::path& path, std::uint64_t size, ReferencedFiles& referenced) {
   return guarded(size, [&] { check_glb_bytes(read_all(path), path.parent_path(), referenced); });
-}
-
-std::string check_3ds(const fs::path& path, std::uint64_t size) {
-  return guarded(size, [&] { check_3ds_bytes(read_all(path)); });
 }
 
 }  // namespace meshes::detail

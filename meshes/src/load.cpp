@@ -235,6 +235,25 @@ void separate_by_normal(std::vector<std::uint32_t>& remap, const std::vector<Vec
   }
 }
 
+// The triangles through the weld `remap`, less those it collapses and those with twice their
+// area under `min_double_area` (counted in `degenerate`).
+std::vector<Triangle> welded_triangles(const Mesh& mesh, const std::vector<std::uint32_t>& remap,
+                                       double min_double_area, std::size_t& degenerate) {
+  std::vector<Triangle> kept;
+  kept.reserve(mesh.triangles.size());
+  for (const Triangle& t : mesh.triangles) {
+    const Triangle w = {remap[t[0]], remap[t[1]], remap[t[2]]};
+    const bool collapsed = w[0] == w[1] || w[1] == w[2] || w[0] == w[2];
+    const double area2 = collapsed ? 0.0 : double_area(mesh, w);
+    if (collapsed || !(area2 > 0.0) || area2 < min_double_area) {
+      ++degenerate;
+      continue;
+    }
+    kept.push_back(w);
+  }
+  return kept;
+}
+
 // Welds, drops degenerate triangles and unused vertices, computes frames: from
 // `file_normals` (one per position) when given, else smooth within creases. `name` starts
 // every error message.
@@ -263,22 +282,8 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
     if (remap[v] != v) ++counts.welded;
   }
 
-  const double min_double_area = kDegenerateAreaRatio * diagonal * diagonal;
-  std::vector<Triangle> kept;
-  kept.reserve(mesh.triangles.size());
-  for (const Triangle& t : mesh.triangles) {
-    const Triangle w = {remap[t[0]], remap[t[1]], remap[t[2]]};
-    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) {
-      ++counts.degenerate;
-      continue;
-    }
-    const double area2 = double_area(mesh, w);
-    if (!(area2 > 0.0) || area2 < min_double_area) {
-      ++counts.degenerate;
-      continue;
-    }
-    kept.push_back(w);
-  }
+  std::vector<Triangle> kept = welded_triangles(
+      mesh, remap, kDegenerateAreaRatio * diagonal * diagonal, counts.degenerate);
 
   // Compact: survivors keep their relative order.
   constexpr std::uint32_t kUnused = 0xFFFFFFFFu;

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace prt {
 namespace {
@@ -134,31 +135,20 @@ void eval_block(const T* __restrict xp, const T* __restrict yp, const T* __restr
 // The order is a template parameter so the recurrence unrolls into straight-line code
 // (about 3x fewer instructions than with run-time loop bounds); this picks the instance.
 template <class T, int W>
+using BlockFn = void (*)(const T*, const T*, const T*, T*, std::ptrdiff_t);
+
+template <class T, int W, int... Orders>
+constexpr std::array<BlockFn<T, W>, sizeof...(Orders)> block_table(
+    std::integer_sequence<int, Orders...>) {
+  return {&eval_block<T, W, Orders + 1>...};
+}
+
+template <class T, int W>
 void eval_dispatch(int order, const T* x, const T* y, const T* z, T* out, std::ptrdiff_t stride) {
-  switch (order) {
-    case 1:
-      return eval_block<T, W, 1>(x, y, z, out, stride);
-    case 2:
-      return eval_block<T, W, 2>(x, y, z, out, stride);
-    case 3:
-      return eval_block<T, W, 3>(x, y, z, out, stride);
-    case 4:
-      return eval_block<T, W, 4>(x, y, z, out, stride);
-    case 5:
-      return eval_block<T, W, 5>(x, y, z, out, stride);
-    case 6:
-      return eval_block<T, W, 6>(x, y, z, out, stride);
-    case 7:
-      return eval_block<T, W, 7>(x, y, z, out, stride);
-    case 8:
-      return eval_block<T, W, 8>(x, y, z, out, stride);
-    case 9:
-      return eval_block<T, W, 9>(x, y, z, out, stride);
-    case 10:
-      return eval_block<T, W, 10>(x, y, z, out, stride);
-    default:
-      check_order(order, "SH order");
-  }
+  static_assert(kMinOrder == 1);
+  check_order(order, "SH order");
+  static constexpr auto kBlocks = block_table<T, W>(std::make_integer_sequence<int, kMaxOrder>());
+  kBlocks[order - 1](x, y, z, out, stride);
 }
 
 template <class T>

@@ -129,27 +129,12 @@ Colour8 cluster_colour(std::uint32_t cluster) {
   const double f = hue - std::floor(hue);
   const double p = value * (1 - saturation), q = value * (1 - saturation * f),
                r = value * (1 - saturation * (1 - f));
-  double rgb[3];
-  switch (sector) {
-    case 0:
-      rgb[0] = value, rgb[1] = r, rgb[2] = p;
-      break;
-    case 1:
-      rgb[0] = q, rgb[1] = value, rgb[2] = p;
-      break;
-    case 2:
-      rgb[0] = p, rgb[1] = value, rgb[2] = r;
-      break;
-    case 3:
-      rgb[0] = p, rgb[1] = q, rgb[2] = value;
-      break;
-    case 4:
-      rgb[0] = r, rgb[1] = p, rgb[2] = value;
-      break;
-    default:
-      rgb[0] = value, rgb[1] = p, rgb[2] = q;
-      break;
-  }
+  // Which of (value, p, q, r) each of red, green and blue takes in each sixth of the hue.
+  static constexpr int kPick[6][3] = {{0, 3, 1}, {2, 0, 1}, {1, 0, 3},
+                                      {1, 2, 0}, {3, 1, 0}, {0, 1, 2}};
+  const double levels[4] = {value, p, q, r};
+  const double rgb[3] = {levels[kPick[sector][0]], levels[kPick[sector][1]],
+                         levels[kPick[sector][2]]};
   return {std::uint8_t(std::lround(rgb[0] * 255)), std::uint8_t(std::lround(rgb[1] * 255)),
           std::uint8_t(std::lround(rgb[2] * 255))};
 }
