@@ -4,7 +4,8 @@ protocol (tests/cdp.py). Opens the page on a generated sphere at 320 x 237, wait
 first frame and checks it is not blank, drags across it and checks the image and the
 environment angle in the statistics change, switches to multipass with one cluster per pass
 and checks passes and overdraw update, toggles the overdraw overlay and checks the image
-changes, opens a second tab with its own state (the first keeps its view), and saves a
+changes, changes the clusters in the page (compressed in the background) and checks the passes
+follow, opens a second tab with its own state (the first keeps its view), and saves a
 screenshot (view_browser.png in TMPDIR). Exit 77 (skip) only when
 /usr/bin/chromium is absent.
 Usage: view_browser_test.py PRTR TMPDIR"""
@@ -82,6 +83,26 @@ def check_second_tab(browser, server):
     check("first tab keeps its mode and passes", text(browser, "stat-mode").startswith("multipass")
           and text(browser, "stat-passes") == "4", text(browser, "stat-mode"))
     check("second tab's angle is its own", second_env.startswith("yaw 0.0°"), second_env)
+
+
+def check_compression(browser):
+    """Clusters chosen in the page: compressed in the background through the cache, the old
+    compression shown until the new one is ready, then the passes follow (multipass at one
+    cluster per pass: one pass per cluster); back to the launch's 4 at once (kept)."""
+    set_control(browser, "clusters", "2")
+    browser.wait_for("document.getElementById('stat-clusters').textContent === '2'",
+                     timeout=60, what="the 2-cluster compression")
+    browser.wait_for("document.getElementById('stat-passes').textContent === '2'",
+                     what="2 passes")
+    check("compression: 2 clusters shown, 2 passes, Average SE of the launch's hidden",
+          text(browser, "stat-se") == "-", text(browser, "stat-se"))
+    check("compression: no progress left on screen",
+          text(browser, "compress-status") == "", text(browser, "compress-status"))
+    set_control(browser, "clusters", "4")
+    browser.wait_for("document.getElementById('stat-passes').textContent === '4'",
+                     what="back to 4 passes")
+    check("compression: the launch's back, with its Average SE",
+          text(browser, "stat-clusters") == "4" and text(browser, "stat-se") != "-")
 
 
 def check_refusals(browser, cx, cy):
@@ -219,6 +240,7 @@ def run(browser, server, tmp):
           shown.startswith("RMS "), shown)
     check("difference view changes the frame", browser.evaluate(PIXELS)["hash"] != overlaid["hash"])
     browser.evaluate("document.getElementById('overlay-difference').click()")
+    check_compression(browser)
     check_refusals(browser, cx, cy)
     check_keys_and_autorotate(browser)
     check_fit_window(browser)

@@ -3,6 +3,7 @@
 // coalesced requests share one frame, clients are served in turn), the JPEG path (the tone
 // map against render::tone_map itself, a JPEG round trip through libjpeg-turbo's decoder),
 // and the camera and environment a state asks for.
+#include "viewer/compressions.h"
 #include "viewer/encode.h"
 #include "viewer/frame.h"
 #include "viewer/queue.h"
@@ -16,10 +17,13 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <future>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 #include <thread>
 
 namespace {
@@ -35,6 +39,9 @@ ViewLimits limits() {
   l.probe_count = 3;
   l.cluster_count = 16;
   l.uncompressed = false;
+  l.max_clusters = 100;
+  l.max_components = 12;
+  l.floats_per_term = 48;  // order 4 glossy: 16 rows x 3 colours
   return l;
 }
 
@@ -49,23 +56,12 @@ TEST(ViewRequest, NoParametersGiveTheDefaults) {
 }
 
 TEST(ViewRequest, EveryParameterLandsInTheState) {
-  const QueryParams q = {{"client", "tab-1_x"},
-                         {"seq", "42"},
-                         {"w", "640"},
-                         {"h", "474"},
-                         {"env_yaw", "-30.5"},
-                         {"env_pitch", "12"},
-                         {"cam_yaw", "90"},
-                         {"cam_pitch", "-45"},
-                         {"zoom", "1.5"},
-                         {"mode", "multipass"},
-                         {"strategy", "order"},
-                         {"budget", "512"},
-                         {"cpp", "4"},
-                         {"probe", "1"},
-                         {"exposure", "-1.25"},
-                         {"overlay", "overdraw"},
-                         {"aa", "2"}};
+  const QueryParams q = {
+      {"client", "tab-1_x"}, {"seq", "42"},         {"w", "640"},          {"h", "474"},
+      {"env_yaw", "-30.5"},  {"env_pitch", "12"},   {"cam_yaw", "90"},     {"cam_pitch", "-45"},
+      {"zoom", "1.5"},       {"mode", "multipass"}, {"strategy", "order"}, {"budget", "512"},
+      {"cpp", "4"},          {"probe", "1"},        {"exposure", "-1.25"}, {"overlay", "overdraw"},
+      {"aa", "2"},           {"clusters", "40"},    {"pcs", "3"}};
   const ViewState s = viewer::parse_view_request(q, limits());
   EXPECT_EQ(s.client, "tab-1_x");
   EXPECT_EQ(s.seq, 42u);
@@ -84,6 +80,8 @@ TEST(ViewRequest, EveryParameterLandsInTheState) {
   EXPECT_EQ(s.exposure, -1.25);
   EXPECT_EQ(s.overlay, viewer::Overlay::kOverdraw);
   EXPECT_EQ(s.samples, 2);
+  EXPECT_EQ(s.clusters, 40);
+  EXPECT_EQ(s.pcs, 3);
   EXPECT_EQ(q.size(), viewer::view_parameter_names().size());  // all of them were covered
 }
 
@@ -165,6 +163,85 @@ TEST(ViewRequest, PassesMustFitInThePagesWords) {
   EXPECT_EQ(refusal({{"budget", "5000"}}).rfind("budget=", 0), 0u);
   EXPECT_EQ(refusal({{"budget", "240"}, {"cpp", "2"}}), "(accepted)");
   EXPECT_EQ(refusal({{"cpp", "16"}}), "(accepted)");  // 34 fit the context's budget
+}
+
+TEST(ViewRequest, OtherCompressionsAreBoundedAndPriceTheirPasses) {
+  const auto refusal = [](const QueryParams& q, const ViewLimits& l) {
+    try {
+      viewer::parse_view_request(q, l);
+    } catch (const RequestError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  ViewLimits l = limits();
+  EXPECT_EQ(refusal({{"clusters", "101"}}, l).rfind("clusters=", 0), 0u);
+  EXPECT_EQ(refusal({{"pcs", "13"}}, l).rfind("pcs=", 0), 0u);
+  EXPECT_EQ(refusal({{"clusters", "0"}, {"pcs", "0"}}, l), "(accepted)");  // the launch's
+  // A pass holds at most the asked-for clusters, not the launch's 16.
+  EXPECT_EQ(refusal({{"clusters", "40"}, {"cpp", "30"}}, l), "(accepted)");
+  EXPECT_EQ(refusal({{"cpp", "30"}}, l).rfind("cpp=", 0), 0u);
+  // One cluster of 3 PCs costs (3 + 1) x 48 / 4 = 48 registers: 2 fit a budget of 100.
+  l.max_register_budget = 4096;
+  EXPECT_EQ(refusal({{"pcs", "3"}, {"budget", "100"}, {"cpp", "3"}}, l),
+            "cpp=3: 2 clusters fit the budget of 100 registers; use 0 (all that fit) or 1 to 2");
+  EXPECT_EQ(refusal({{"pcs", "3"}, {"budget", "100"}, {"cpp", "2"}}, l), "(accepted)");
+  // A viewer without other compressions takes only the launch's.
+  l.max_clusters = l.max_components = 0;
+  EXPECT_EQ(refusal({{"clusters", "0"}}, l), "(accepted)");
+  EXPECT_EQ(refusal({{"clusters", "8"}}, l),
+            "clusters='8': this viewer offers only its launch compression");
+}
+
+// A compression made on request: the launch's is shown until the new one is ready, then the
+// new one; a failure is reported and leaves the shown one; the launch's is one request away.
+TEST(ViewCompressions, TheOldOneIsShownUntilTheNewOneIsReady) {
+  cpca::CompressedSet launch;
+  launch.cluster_count = 16;
+  launch.component_count = 4;
+  std::promise<void> release;
+  std::shared_future<void> gate = release.get_future().share();
+  std::atomic<int> made{0};
+  viewer::Compressions c(launch, [&](int clusters, int pcs, const auto& progress) {
+    progress(0.5);
+    gate.wait();
+    if (clusters == 7) throw std::runtime_error("7 clusters refused");
+    ++made;
+    cpca::CompressedSet s;
+    s.cluster_count = clusters;
+    s.component_count = pcs;
+    return s;
+  });
+  viewer::CompressionStatus st = c.choose(8, 0);
+  EXPECT_TRUE(st.pending);
+  EXPECT_EQ(st.shown->cluster_count, 16);
+  const auto wait_ready = [&](int clusters, int pcs) {
+    for (int i = 0; i < 2000; ++i) {
+      st = c.choose(clusters, pcs);
+      if (!st.pending) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    FAIL() << "not ready in 10 s";
+  };
+  for (int i = 0; i < 200 && st.progress < 0.5; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    st = c.choose(8, 0);
+  }
+  EXPECT_EQ(st.progress, 0.5);
+  EXPECT_EQ(st.shown->cluster_count, 16);  // still the launch's
+  release.set_value();
+  wait_ready(8, 0);
+  EXPECT_EQ(st.shown->cluster_count, 8);
+  EXPECT_EQ(st.shown->component_count, 4);  // pcs 0: the launch's
+  wait_ready(7, 2);
+  EXPECT_EQ(st.error, "7 clusters refused");
+  EXPECT_EQ(st.shown->cluster_count, 8);  // the failure leaves the shown one
+  st = c.choose(0, 0);
+  EXPECT_FALSE(st.pending);
+  EXPECT_EQ(st.shown->cluster_count, 16);
+  st = c.choose(8, 4);  // made once, kept
+  EXPECT_FALSE(st.pending);
+  EXPECT_EQ(made.load(), 1);
 }
 
 TEST(ViewRequest, RawQueriesAreSplitStrictly) {

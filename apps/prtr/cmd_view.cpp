@@ -110,6 +110,8 @@ Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::Compresse
               {"triangles", mesh.triangle_count()},
               {"clusters", set.cluster_count},
               {"pcs", set.component_count},
+              {"max_clusters", served.limits.max_clusters},
+              {"max_pcs", served.limits.max_components},
               {"order", set.order},
               {"average_se", summary.average_se},
               {"relative_error", summary.relative_error},
@@ -168,9 +170,28 @@ void run(const Options& o, CLI::App*) {
   const pipeline::CacheResult transfer = pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
   const pipeline::CompressCacheResult compressed =
       pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
-  const cpca::CompressedSet set = cpca::read_compressed(compressed.path);
-  viewer::ViewScene scene({&mesh, &set, transfer.path, probes, placement, background, axis, gl});
+  // Other clusters and PCs from the page: the same cached compression, in the background.
+  const auto make = [&](int clusters, int pcs, const std::function<void(double)>& progress) {
+    cpca::CompressOptions c = compress;
+    c.clusters = clusters;
+    c.components = pcs;
+    pipeline::Reporter quiet;
+    quiet.progress = [&](const std::string&, std::uint64_t done, std::uint64_t total) {
+      if (total > 0) progress(double(done) / double(total));
+    };
+    return cpca::read_compressed(
+        pipeline::cached_compress(transfer.path, mesh, o.mesh, c, cache, quiet).path);
+  };
+  viewer::Compressions compressions(cpca::read_compressed(compressed.path), make);
+  const cpca::CompressedSet& set = compressions.launch();
+  viewer::ViewScene scene(
+      {&mesh, &compressions, transfer.path, probes, placement, background, axis, gl});
   served.limits = {int(probes.size()), set.cluster_count, true};
+  // The page may ask for up to 64 PCs; the compression refuses more than the data holds.
+  served.limits.max_clusters = int(std::min<std::size_t>(mesh.vertex_count(), 65536));
+  served.limits.max_components = 64;
+  served.limits.floats_per_term =
+      render::constant_layout(set.order, set.glossy(), 0).floats_per_cluster();
   served.limits.max_register_budget = scene.info().default_register_budget;
   served.limits.registers_per_cluster = scene.info().registers_per_cluster;
   // The initial state renders once here, so a flag the renderer refuses exits 2 now.

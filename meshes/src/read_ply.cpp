@@ -78,9 +78,9 @@ class Values {
   // Empty on success, else the problem.
   std::string next(Scalar type, double& value) {
     if (format_ == Format::kAscii) return next_text(type, value);
-    const std::size_t n = size_of(type);
-    if (n > body_.size() - at_) return "the file ends in the middle of the data";
     unsigned char b[8];
+    const std::size_t n = std::min(size_of(type), sizeof b);  // 1 to 8; bounded for the compiler
+    if (n > body_.size() - at_) return "the file ends in the middle of the data";
     std::memcpy(b, body_.data() + at_, n);
     at_ += n;
     if ((format_ == Format::kBig) != (std::endian::native == std::endian::big)) {

@@ -41,6 +41,9 @@ auto-rotates, r resets</div>
 <div class="refused" id="refused-budget"></div>
 <label>clusters per pass <input id="cpp" type="number" min="0" step="1" value="0"> (0: all that fit)</label>
 <div class="refused" id="refused-cpp"></div>
+<label>clusters <input id="clusters" type="number" min="1" step="1"> PCs <input id="pcs" type="number" min="1" step="1"></label>
+<div class="refused" id="refused-clusters"></div><div class="refused" id="refused-pcs"></div>
+<div id="compress-status"></div>
 <label>size <select id="size"></select></label>
 <label><input type="checkbox" id="antialias" checked> anti-alias the still image (<span id="antialias-samples">2 × 2</span> samples once the view stops)</label>
 <div class="refused" id="refused-size"></div>
@@ -85,13 +88,14 @@ const client = "c" + Math.random().toString(36).slice(2, 12);
 const urlParams = new URLSearchParams(location.search);
 const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch: 0, zoom: 1,
   mode: "decoupled", strategy: "greedy-refine", budget: 0, cpp: 0, probe: 0, exposure: 0,
-  overlay: "none", aa: 1 };
+  overlay: "none", aa: 1, clusters: 0, pcs: 0 };
 let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
 let good = null;         // the last state that rendered: a refused setting falls back to it
 let stillSamples = 2;    // prtr view --supersample: samples per pixel of a still view
 // Which control sets a query parameter, so that a refusal is shown beside it.
 const controlOf = { budget: "budget", cpp: "cpp", w: "size", h: "size", mode: "mode",
-  strategy: "strategy", probe: "probe", exposure: "exposure" };
+  strategy: "strategy", probe: "probe", exposure: "exposure", clusters: "clusters", pcs: "pcs" };
+let launch = null;       // the launch compression's clusters, PCs and Average SE (/api/info)
 const log = [];          // per frame: {sent, shown, queue, render, overlay, encode, transfer}
 window.prtrLog = log;    // read by the measurement script
 
@@ -157,6 +161,7 @@ async function pump() {
                  transfer: Math.max(0, now - sent - server), total: now - sent });
       if (log.length > 2000) log.splice(0, 1000);
       showStats(f, now - sent, server);
+      showCompression(f);
       $("stat-error").textContent = "";
     }
   } catch (e) { $("stat-error").textContent = String(e); }
@@ -173,6 +178,23 @@ function refineStill() {
   state.aa = stillSamples;
   dirty = true;
   pump();
+}
+
+// Another compression is made in the background while the last ready one stays on screen:
+// its progress is shown, and the view is asked for again until it arrives.
+let compressPoll = null;
+function showCompression(f) {
+  $("stat-clusters").textContent = String(f.clusters);
+  $("stat-pcs").textContent = String(f.pcs);
+  const atLaunch = launch && f.clusters === launch.clusters && f.pcs === launch.pcs;
+  $("stat-se").textContent = atLaunch ? launch.average_se.toPrecision(4) : "-";
+  const asked = (state.clusters || f.clusters) + " × " + (state.pcs || f.pcs);
+  $("compress-status").textContent = f.compressing
+      ? "compressing " + asked + ": " + Math.round(100 * f.compress_progress) + " % (showing " +
+        f.clusters + " × " + f.pcs + ")" : "";
+  $("refused-clusters").textContent = f.compress_error ? asked + ": " + f.compress_error : "";
+  if (f.compressing && !compressPoll)
+    compressPoll = setTimeout(() => { compressPoll = null; dirty = true; pump(); }, 400);
 }
 
 function showStats(f, total, server) {
@@ -275,9 +297,10 @@ function bindSelect(id, key, parse) {
 bindSelect("mode", "mode", String);
 bindSelect("strategy", "strategy", String);
 bindSelect("probe", "probe", Number);
-for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"]])
+for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"], ["clusters", "clusters"], ["pcs", "pcs"]])
   $(id).addEventListener("change", () => {
-    state[key] = Math.max(0, Math.floor(Number($(id).value) || 0));
+    const least = key === "clusters" || key === "pcs" ? 1 : 0;
+    state[key] = Math.max(least, Math.floor(Number($(id).value) || 0));
     $(id).value = String(state[key]);
     $("refused-" + id).textContent = "";
     changed();
@@ -351,6 +374,10 @@ async function start() {
   $("exposure-value").textContent = state.exposure.toFixed(2);
   $("stat-clusters").textContent = String(info.clusters);
   $("stat-pcs").textContent = String(info.pcs);
+  launch = { clusters: info.clusters, pcs: info.pcs, average_se: info.average_se };
+  state.clusters = info.clusters; state.pcs = info.pcs;
+  $("clusters").value = String(info.clusters); $("pcs").value = String(info.pcs);
+  $("clusters").max = String(info.max_clusters); $("pcs").max = String(info.max_pcs);
   $("stat-order").textContent = String(info.order);
   $("stat-se").textContent = info.average_se.toPrecision(4);
   $("stat-mesh").textContent = info.mesh + " (" + info.vertices + " vertices)";

@@ -65,6 +65,13 @@ bool valid_client(const std::string& id) {
 
 using Setter = std::function<void(ViewState&, const std::string&, const ViewLimits&)>;
 
+// clusters= or pcs=: 1 to `max`, or 0 for the launch's; refused where the viewer offers no
+// other compression.
+int compression_size(const char* name, const std::string& v, int max) {
+  if (max <= 0 && v != "0") reject(name, v, "this viewer offers only its launch compression");
+  return int(parse_integer(name, v, 0, max));
+}
+
 void set_client(ViewState& s, const std::string& v, const ViewLimits&) {
   if (!valid_client(v)) reject("client", v, "use 1-32 of A-Z a-z 0-9 _ -");
   s.client = v;
@@ -122,8 +129,15 @@ const std::vector<std::pair<std::string, Setter>>& setters() {
        [](S& s, V v, L l) {
          s.register_budget = int(parse_integer("budget", v, 0, l.max_register_budget));
        }},
-      {"cpp", [](S& s, V v,
-                 L l) { s.clusters_per_pass = int(parse_integer("cpp", v, 0, l.cluster_count)); }},
+      // After "clusters" (the table is read in key order): a pass holds at most all clusters.
+      {"cpp",
+       [](S& s, V v, L l) {
+         s.clusters_per_pass =
+             int(parse_integer("cpp", v, 0, s.clusters > 0 ? s.clusters : l.cluster_count));
+       }},
+      {"clusters",
+       [](S& s, V v, L l) { s.clusters = compression_size("clusters", v, l.max_clusters); }},
+      {"pcs", [](S& s, V v, L l) { s.pcs = compression_size("pcs", v, l.max_components); }},
       {"probe",
        [](S& s, V v, L l) { s.probe = int(parse_integer("probe", v, 0, l.probe_count - 1)); }},
       {"exposure", [](S& s, V v, L) { s.exposure = parse_double("exposure", v, -20, 20); }},
@@ -199,8 +213,11 @@ namespace {
 // decides (the renderer's own refusal names command-line flags), this says which values
 // would fit.
 void check_passes(const ViewState& state, const ViewLimits& limits) {
+  const int cost = state.pcs > 0 && limits.floats_per_term > 0
+                       ? ((state.pcs + 1) * limits.floats_per_term + 3) / 4
+                       : limits.registers_per_cluster;
   const render::PassCapacity c =
-      render::check_pass_capacity(std::max(1, limits.registers_per_cluster), state.register_budget,
+      render::check_pass_capacity(std::max(1, cost), state.register_budget,
                                   limits.max_register_budget, state.clusters_per_pass);
   const std::string context = std::to_string(limits.max_register_budget);
   switch (c.problem) {

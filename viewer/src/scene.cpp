@@ -40,15 +40,17 @@ constexpr double kDifferenceFullScale = 0.1;  // the difference view's red: 10 %
 
 struct CachedRenderer {
   std::string key;
+  std::shared_ptr<const cpca::CompressedSet> set;  // kept alive while its renderer is
   std::unique_ptr<render::Renderer> renderer;
   std::vector<std::uint8_t> pass_counts;  // per triangle, for the overdraw overlay
   int probe = -1;                         // the probe its background texture holds
 };
 
-std::string renderer_key(const ViewState& s) {
+std::string renderer_key(const ViewState& s, const cpca::CompressedSet& set) {
   const bool grouped = s.mode == render::Mode::kMultipass || s.mode == render::Mode::kDecoupled;
   return std::string(render::kModeNames.name(s.mode)) + "/" + (grouped ? s.strategy : "-") + "/" +
-         std::to_string(s.register_budget) + "/" + std::to_string(s.clusters_per_pass);
+         std::to_string(s.register_budget) + "/" + std::to_string(s.clusters_per_pass) + "/" +
+         std::to_string(set.cluster_count) + "x" + std::to_string(set.component_count);
 }
 
 }  // namespace
@@ -56,14 +58,16 @@ std::string renderer_key(const ViewState& s) {
 struct ViewScene::Impl {
   explicit Impl(SceneInputs in) : inputs(std::move(in)) {}
 
-  CachedRenderer& renderer_for(const ViewState& state);
+  CachedRenderer& renderer_for(const ViewState& state,
+                               const std::shared_ptr<const cpca::CompressedSet>& set);
   const prt::ShLighting& lighting_for(int probe);
   const probes::Probe& probe_texels(int probe);
-  std::vector<std::uint8_t> pass_counts(const render::Renderer& r,
+  std::vector<std::uint8_t> pass_counts(const render::Renderer& r, const cpca::CompressedSet& set,
                                         const std::optional<cpca::SuperClusters>& groups) const;
   void add_overlay(RenderedFrame& frame, const CachedRenderer& cached,
                    const render::Camera& camera) const;
-  void add_difference(RenderedFrame& frame, const render::Camera& drawn, const prt::ShLighting& sh);
+  void add_difference(RenderedFrame& frame, const render::Camera& drawn, const prt::ShLighting& sh,
+                      const std::shared_ptr<const cpca::CompressedSet>& set);
   void render_into(RenderedFrame& frame);
 
   SceneInputs inputs;
@@ -90,26 +94,30 @@ const probes::Probe& ViewScene::Impl::probe_texels(int probe) {
 const prt::ShLighting& ViewScene::Impl::lighting_for(int probe) {
   auto it = lighting.find(probe);
   if (it == lighting.end())
-    it = lighting.emplace(probe, prt::project(probe_texels(probe), inputs.set->order)).first;
+    it = lighting
+             .emplace(probe, prt::project(probe_texels(probe), inputs.compressions->launch().order))
+             .first;
   return it->second;
 }
 
 std::vector<std::uint8_t> ViewScene::Impl::pass_counts(
-    const render::Renderer& r, const std::optional<cpca::SuperClusters>& groups) const {
+    const render::Renderer& r, const cpca::CompressedSet& set,
+    const std::optional<cpca::SuperClusters>& groups) const {
   const meshes::Mesh& mesh = *inputs.mesh;
   if (r.mode() != render::Mode::kMultipass)
     return std::vector<std::uint8_t>(mesh.triangle_count(), 1);
   const std::vector<cpca::TriangleIndices> triangles(mesh.triangles.begin(), mesh.triangles.end());
-  if (groups) return cpca::triangle_pass_counts(inputs.set->cluster_of, triangles, *groups);
+  if (groups) return cpca::triangle_pass_counts(set.cluster_of, triangles, *groups);
   // No grouping given: the renderer filled its passes in cluster order.
-  const cpca::SuperClusterInput input{inputs.set->cluster_of, triangles, inputs.set->cluster_count,
+  const cpca::SuperClusterInput input{set.cluster_of, triangles, set.cluster_count,
                                       r.stats().clusters_per_pass};
-  return cpca::triangle_pass_counts(inputs.set->cluster_of, triangles,
+  return cpca::triangle_pass_counts(set.cluster_of, triangles,
                                     cpca::group_clusters("order", input));
 }
 
-CachedRenderer& ViewScene::Impl::renderer_for(const ViewState& state) {
-  const std::string key = renderer_key(state);
+CachedRenderer& ViewScene::Impl::renderer_for(
+    const ViewState& state, const std::shared_ptr<const cpca::CompressedSet>& set) {
+  const std::string key = renderer_key(state, *set);
   for (auto it = renderers.begin(); it != renderers.end(); ++it)
     if (it->key == key) {
       renderers.splice(renderers.begin(), renderers, it);
@@ -123,19 +131,19 @@ CachedRenderer& ViewScene::Impl::renderer_for(const ViewState& state) {
   ro.clusters_per_pass = state.clusters_per_pass;
   std::optional<cpca::SuperClusters> groups;
   if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
-    ro.groups = groups =
-        render::group_for_renderer(*inputs.mesh, *inputs.set, context, ro.register_budget,
-                                   ro.clusters_per_pass, state.strategy);
+    ro.groups = groups = render::group_for_renderer(*inputs.mesh, *set, context, ro.register_budget,
+                                                    ro.clusters_per_pass, state.strategy);
   if (ro.mode == render::Mode::kUncompressed && !transfer)
     transfer = prt::read_transfer(inputs.transfer);
   const probes::Probe& probe = probe_texels(state.probe);
   CachedRenderer cached;
   cached.key = key;
+  cached.set = set;
   cached.renderer = std::make_unique<render::Renderer>(
-      *inputs.mesh, inputs.set, ro.mode == render::Mode::kUncompressed ? &*transfer : nullptr,
+      *inputs.mesh, set.get(), ro.mode == render::Mode::kUncompressed ? &*transfer : nullptr,
       &probe, ro);
   cached.renderer->set_background(inputs.background);
-  cached.pass_counts = pass_counts(*cached.renderer, groups);
+  cached.pass_counts = pass_counts(*cached.renderer, *set, groups);
   cached.probe = state.probe;
   renderers.push_front(std::move(cached));
   return renderers.front();
@@ -150,7 +158,7 @@ void ViewScene::Impl::add_overlay(RenderedFrame& frame, const CachedRenderer& ca
   if (frame.state.overlay == Overlay::kOverdraw)
     frame.overlay = render::overdraw_picture(*inputs.mesh, camera, cached.pass_counts, po);
   else
-    frame.overlay = render::cluster_picture(*inputs.mesh, camera, inputs.set->cluster_of, po);
+    frame.overlay = render::cluster_picture(*inputs.mesh, camera, cached.set->cluster_of, po);
   frame.stats.overlay_ms = ms_since(start);
 }
 
@@ -158,7 +166,13 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   const ViewState& s = frame.state;
   const auto start = Clock::now();
   const auto setup_start = Clock::now();
-  CachedRenderer& cached = renderer_for(s);
+  const CompressionStatus compression = inputs.compressions->choose(s.clusters, s.pcs);
+  frame.stats.clusters = compression.shown->cluster_count;
+  frame.stats.pcs = compression.shown->component_count;
+  frame.stats.compressing = compression.pending;
+  frame.stats.compress_progress = compression.progress;
+  frame.stats.compress_error = compression.error;
+  CachedRenderer& cached = renderer_for(s, compression.shown);
   const prt::ShLighting& sh = lighting_for(s.probe);
   if (cached.probe != s.probe) {
     cached.renderer->set_probe(&probe_texels(s.probe));
@@ -184,7 +198,7 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   frame.stats.clusters_per_pass = rs.clusters_per_pass;
   frame.stats.register_budget = rs.register_budget;
   if (s.overlay == Overlay::kDifference)
-    add_difference(frame, drawn, sh);
+    add_difference(frame, drawn, sh, compression.shown);
   else
     add_overlay(frame, cached, camera);
 }
@@ -192,12 +206,13 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
 // The same view through the uncompressed transfer (its own cached renderer), then the
 // difference picture of the two.
 void ViewScene::Impl::add_difference(RenderedFrame& frame, const render::Camera& drawn,
-                                     const prt::ShLighting& sh) {
+                                     const prt::ShLighting& sh,
+                                     const std::shared_ptr<const cpca::CompressedSet>& set) {
   const auto start = Clock::now();
   const ViewState& s = frame.state;
   ViewState reference_state = s;
   reference_state.mode = render::Mode::kUncompressed;
-  CachedRenderer& reference = renderer_for(reference_state);
+  CachedRenderer& reference = renderer_for(reference_state, set);
   if (reference.probe != s.probe) {
     reference.renderer->set_probe(&probe_texels(s.probe));
     reference.probe = s.probe;
@@ -222,7 +237,8 @@ ViewScene::ViewScene(SceneInputs inputs) : impl_(std::make_unique<Impl>(std::mov
   m.info.gl_renderer = gl.renderer;
   m.info.gl_version = gl.version;
   m.info.default_register_budget = gl.default_register_budget();
-  m.info.registers_per_cluster = render::constant_layout(*m.inputs.set).registers_per_cluster();
+  m.info.registers_per_cluster =
+      render::constant_layout(m.inputs.compressions->launch()).registers_per_cluster();
   // llvmpipe's rasteriser threads: LP_NUM_THREADS when set, else one per CPU.
   const char* lp = std::getenv("LP_NUM_THREADS");
   m.info.llvmpipe_threads = lp ? std::atoi(lp) : int(std::thread::hardware_concurrency());

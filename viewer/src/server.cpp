@@ -226,7 +226,12 @@ Json frame_header(const RenderedFrame& f) {
               {"difference_rms", t.difference_rms},
               {"difference_max", t.difference_max},
               {"encode_ms", f.encode_ms},
-              {"requests", t.requests}};
+              {"requests", t.requests},
+              {"clusters", t.clusters},
+              {"pcs", t.pcs},
+              {"compressing", t.compressing},
+              {"compress_progress", t.compress_progress},
+              {"compress_error", t.compress_error}};
 }
 
 void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions& options) {

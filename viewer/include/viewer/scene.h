@@ -9,6 +9,7 @@
 #include "render/camera.h"
 #include "render/gl_context.h"
 #include "render/renderer.h"
+#include "viewer/compressions.h"
 #include "viewer/frame.h"
 #include "viewer/request.h"
 
@@ -21,8 +22,8 @@ namespace viewer {
 
 struct SceneInputs {
   const meshes::Mesh* mesh = nullptr;
-  const cpca::CompressedSet* set = nullptr;
-  std::filesystem::path transfer;  // the cached bake, loaded on the first uncompressed frame
+  Compressions* compressions = nullptr;  // the launch's compression and any the page asks for
+  std::filesystem::path transfer;        // the cached bake, loaded on the first uncompressed frame
   std::vector<std::filesystem::path> probes;
   render::CameraPlacement camera;  // framing before the page orbits it (size comes per request)
   render::Background background;
