@@ -30,6 +30,7 @@
 #include <cstdlib>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -312,33 +313,48 @@ void print_white_sky(const prt::TransferSet& t, const meshes::Mesh& sphere, prt:
               100 * sky_err[0], 100 * p99, 100 * abs_err.back());
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct Args {
   bool quick = false;
   double lambda = prt::kViewFitLambda;
   std::vector<std::string> probe_paths;
-  std::vector<prt::ViewFit> fits(std::begin(kFits), std::end(kFits));
+  std::vector<prt::ViewFit> fits{std::begin(kFits), std::end(kFits)};
+};
+
+// nullopt on a usage error (printed).
+std::optional<Args> parse_args(int argc, char** argv) {
+  Args a;
   for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--quick") {
-      quick = true;
-    } else if (a == "--fit" && i + 1 < argc) {
-      fits = {prt::kViewFitNames.parse(argv[++i])};
-    } else if (a == "--lambda" && i + 1 < argc) {
-      lambda = std::atof(argv[++i]);
-    } else if (!a.empty() && a[0] == '-') {
+    const std::string arg = argv[i];
+    if (arg == "--quick") {
+      a.quick = true;
+    } else if (arg == "--fit" && i + 1 < argc) {
+      a.fits = {prt::kViewFitNames.parse(argv[++i])};
+    } else if (arg == "--lambda" && i + 1 < argc) {
+      a.lambda = std::atof(argv[++i]);
+    } else if (!arg.empty() && arg[0] == '-') {
       std::fprintf(stderr,
                    "usage: glossy_fidelity_bench [--quick] [--fit FIT] [--lambda L] [PROBE ...]\n");
-      return 2;
+      return std::nullopt;
     } else {
-      probe_paths.push_back(a);
+      a.probe_paths.push_back(arg);
     }
   }
-  if (probe_paths.empty()) {
+  if (a.probe_paths.empty()) {
     const std::string dir = "/usr/share/blender/datafiles/studiolights/world/";
-    probe_paths = {dir + "forest.exr", dir + "city.exr"};
+    a.probe_paths = {dir + "forest.exr", dir + "city.exr"};
   }
+  return a;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::optional<Args> args = parse_args(argc, argv);
+  if (!args) return 2;
+  const bool quick = args->quick;
+  const double lambda = args->lambda;
+  const std::vector<std::string>& probe_paths = args->probe_paths;
+  const std::vector<prt::ViewFit>& fits = args->fits;
   const std::vector<int> orders =
       quick ? std::vector<int>{2, 6, 10} : std::vector<int>{2, 4, 6, 8, 10};
   const auto start = Clock::now();
