@@ -282,8 +282,8 @@ CleanCounts clean(Mesh& mesh, const LoadOptions& options, const std::string& nam
     if (remap[v] != v) ++counts.welded;
   }
 
-  std::vector<Triangle> kept = welded_triangles(
-      mesh, remap, kDegenerateAreaRatio * diagonal * diagonal, counts.degenerate);
+  std::vector<Triangle> kept =
+      welded_triangles(mesh, remap, kDegenerateAreaRatio * diagonal * diagonal, counts.degenerate);
 
   // Compact: survivors keep their relative order.
   constexpr std::uint32_t kUnused = 0xFFFFFFFFu;
