@@ -192,7 +192,8 @@ function showCompression(f) {
   $("compress-status").textContent = f.compressing
       ? "compressing " + asked + ": " + Math.round(100 * f.compress_progress) + " % (showing " +
         f.clusters + " × " + f.pcs + ")" : "";
-  $("refused-clusters").textContent = f.compress_error ? asked + ": " + f.compress_error : "";
+  // Cleared when the field changes, so a refusal the server gave stays readable meanwhile.
+  if (f.compress_error) $("refused-clusters").textContent = asked + ": " + f.compress_error;
   if (f.compressing && !compressPoll)
     compressPoll = setTimeout(() => { compressPoll = null; dirty = true; pump(); }, 400);
 }
