@@ -84,14 +84,24 @@ struct Args {
   render::GlSelection gl;
   int frames = 15, width = 1280, height = 948;
   render::Accumulation accumulation = render::Accumulation::kAuto;
+  render::Constants constants = render::Constants::kAuto;
 };
+
+template <typename Table>
+auto parse_named(const Table& table, const std::string& flag, const std::string& value) {
+  try {
+    return table.parse(value);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(flag + ": " + e.what());
+  }
+}
 
 Args parse_args(int argc, char** argv) {
   if (argc < 2)
     throw UsageError(
         "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] "
         "[--mesh M] [--frames F] [--width W] [--height H] [--gl osmesa|egl] "
-        "[--gl-device N] [--accumulation auto|rgba32f|rgba16f]");
+        "[--gl-device N] [--accumulation auto|rgba32f|rgba16f] [--constants auto|cpu|gpu]");
   Args a;
   a.compressed = argv[1];
   try {
@@ -118,11 +128,9 @@ Args parse_args(int argc, char** argv) {
         throw UsageError("--gl-device " + value + " is not a device index");
       a.gl.device = int(n);
     } else if (flag == "--accumulation") {
-      try {
-        a.accumulation = render::kAccumulationNames.parse(value);
-      } catch (const std::invalid_argument& e) {
-        throw UsageError(std::string("--accumulation: ") + e.what());
-      }
+      a.accumulation = parse_named(render::kAccumulationNames, flag, value);
+    } else if (flag == "--constants") {
+      a.constants = parse_named(render::kConstantsNames, flag, value);
     } else if (flag == "--frames") {
       a.frames = std::atoi(value.c_str());
     } else if (flag == "--width") {
@@ -236,6 +244,7 @@ std::optional<Sample> run_row(const Scene& s, const Args& a, const Floors& floor
   const std::string name = std::string(row.name) + (feedback ? "" : ", in-draw");
   render::RendererOptions o;
   o.accumulation = a.accumulation;
+  o.constants = a.constants;
   o.multipass_feedback = feedback;
   o.mode = row.mode;
   o.clusters_per_pass = row.clusters_per_pass;
@@ -312,9 +321,10 @@ void run(const Args& a) {
                      std::to_string(render::list_egl_devices().size()) + " devices");
   render::GlContext context(a.gl);
   const render::GlInfo gl_info = context.info();
-  std::printf("render_bench: %s, %s, %s, %s accumulation\n", context.description().c_str(),
-              gl_info.renderer.c_str(), gl_info.version.c_str(),
-              render::kAccumulationNames.name(render::resolve_accumulation(a.accumulation)));
+  std::printf("render_bench: %s, %s, %s, %s accumulation, constants %s\n",
+              context.description().c_str(), gl_info.renderer.c_str(), gl_info.version.c_str(),
+              render::kAccumulationNames.name(render::resolve_accumulation(a.accumulation)),
+              render::kConstantsNames.name(a.constants));
   std::printf(
       "render_bench: %s, %zu vertices, %zu triangles, %d clusters x %d PCs, order %d, "
       "%d x %d, %d frames (median)\n",

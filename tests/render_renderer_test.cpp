@@ -200,16 +200,51 @@ TEST_P(CaptureTest, EveryModeMatchesTheCpuReference) {
   const int registers = render::constant_layout(s.set).registers_per_cluster();
   for (render::Mode mode : {render::Mode::kMultipass, render::Mode::kSinglepass,
                             render::Mode::kDecoupled, render::Mode::kCpu})
-    for (bool feedback : {true, false}) {
-      if (!feedback && mode != render::Mode::kMultipass) continue;
-      // Three clusters per pass: several passes, so the sum over passes is exercised.
-      render::RendererOptions o = options(mode, 3 * registers);
-      o.multipass_feedback = feedback;
-      render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
-      const auto captured = r.capture_vertex_radiance(s.camera, s.lighting, R);
-      EXPECT_LT(max_relative_error(captured, reference), kVertexTolerance)
-          << render::kModeNames.name(mode) << (feedback ? "" : ", in-draw shading");
-    }
+    for (bool feedback : {true, false})
+      for (render::Constants constants : {render::Constants::kCpu, render::Constants::kGpu}) {
+        if (!feedback && mode != render::Mode::kMultipass) continue;
+        // Three clusters per pass: several passes, so the sum over passes is exercised.
+        render::RendererOptions o = options(mode, 3 * registers);
+        o.multipass_feedback = feedback;
+        o.constants = constants;
+        render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
+        const auto captured = r.capture_vertex_radiance(s.camera, s.lighting, R);
+        const std::string label = std::string(render::kModeNames.name(mode)) +
+                                  (feedback ? "" : ", in-draw shading") + ", constants on the " +
+                                  render::kConstantsNames.name(constants);
+        EXPECT_LT(max_relative_error(captured, reference), kVertexTolerance) << label;
+        // The CPU-shaded path needs the constants on the host whatever was asked.
+        EXPECT_EQ(r.stats().constants,
+                  mode == render::Mode::kCpu ? render::Constants::kCpu : constants)
+            << label;
+      }
+}
+
+// The compute dispatch reruns every frame: after one rotation and then another, the image is
+// the CPU constants' image of the second, and differs from the first's.
+TEST(Renderer, GpuConstantsFollowTheLightingFrameByFrame) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_plane_and_sphere(3.f, 8, 0.5f, 1.0f, 16, 8), 4, 10, 3);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  const Eigen::Matrix3d first = test_rotation();
+  const Eigen::Matrix3d second = prt::axis_angle(Eigen::Vector3d(0, 1, 0), 2.1) * first;
+  for (render::Mode mode :
+       {render::Mode::kMultipass, render::Mode::kSinglepass, render::Mode::kDecoupled}) {
+    render::RendererOptions o = options(mode, 3 * registers);
+    render::RenderStats stats;
+    const render::Image cpu = render_once(ctx, s, o, s.camera, second, &stats);
+    EXPECT_EQ(stats.constants, render::Constants::kCpu) << "kAuto on llvmpipe";
+    o.constants = render::Constants::kGpu;
+    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
+    r.render(s.camera, s.lighting, first);
+    const render::Image before = r.read_image();
+    r.render(s.camera, s.lighting, second);
+    const render::Image after = r.read_image();
+    const double peak = cpu.max_rgb();
+    ASSERT_GT(peak, 0.0);
+    EXPECT_LE(max_abs_difference(after, cpu) / peak, 1e-5) << render::kModeNames.name(mode);
+    EXPECT_GT(max_abs_difference(before, cpu) / peak, 1e-2) << render::kModeNames.name(mode);
+  }
 }
 
 // Named "glossy_order3_grey" etc., so CTest lists the case rather than the parameter's bytes.

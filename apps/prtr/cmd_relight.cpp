@@ -82,7 +82,7 @@ struct Options {
   int supersample = kDefaultSupersample;
   double degrees = 360.0;
   bool quiet = false, no_video = false;
-  std::string exr_pixels = "half", accumulation = "auto";
+  std::string exr_pixels = "half", accumulation = "auto", constants = "auto";
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
@@ -107,6 +107,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_supersample_flag(cmd, o.supersample);
   add_gl_flags(cmd, o.gl);
   add_accumulation_flag(cmd, o.accumulation);
+  add_constants_flag(cmd, o.constants);
   cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
   add_checked_option(cmd, "--columns", o.columns, "Contact sheet columns", integer_in(1, 64));
   add_checked_option(cmd, "--thumbnail", o.thumbnail, "Contact sheet thumbnail width (pixels)",
@@ -163,6 +164,7 @@ std::unique_ptr<render::Renderer> make_renderer(const Options& o, const meshes::
   render::RendererOptions ro;
   ro.mode = render::kModeNames.parse(o.mode);
   ro.accumulation = render::kAccumulationNames.parse(o.accumulation);
+  ro.constants = render::kConstantsNames.parse(o.constants);
   ro.register_budget = o.register_budget;
   try {
     if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)

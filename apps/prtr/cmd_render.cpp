@@ -44,7 +44,7 @@ std::string count_list(const std::vector<std::uint64_t>& values) {
 
 struct Options {
   std::string compressed, probe, mesh, transfer, output, png, mode = "multipass";
-  std::string strategy = "order", accumulation = "auto";
+  std::string strategy = "order", accumulation = "auto", constants = "auto";
   ViewFlags view;
   GlFlags gl;
   MeshFlags mesh_flags;
@@ -90,6 +90,7 @@ void add_flags(CLI::App* cmd, Options& o) {
                 "Keep triangles in mesh order (no vertex-cache order)");
   add_gl_flags(cmd, o.gl);
   add_accumulation_flag(cmd, o.accumulation);
+  add_constants_flag(cmd, o.constants);
   cmd->add_flag("--json", o.json, "Print one JSON line of results");
   cmd->add_flag("-q,--quiet", o.quiet, "Print nothing but errors (and the --json line)");
 }
@@ -99,6 +100,7 @@ render::RendererOptions renderer_options(const Options& o, const CLI::App* cmd) 
   render::RendererOptions ro;
   ro.mode = render::kModeNames.parse(o.mode);
   ro.accumulation = render::kAccumulationNames.parse(o.accumulation);
+  ro.constants = render::kConstantsNames.parse(o.constants);
   ro.register_budget = o.register_budget;
   ro.clusters_per_pass = o.clusters_per_pass;
   ro.cull_back_faces = !o.no_cull;
@@ -172,9 +174,10 @@ void print_report(const Options& o, const render::RenderStats& st,
                 o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
     std::printf(
         "mode        %s, %d pass(es), %d cluster(s) per pass, budget %d vec4 (%d per cluster), "
-        "%s target\n",
+        "%s target, constants on the %s\n",
         o.mode.c_str(), st.passes, st.clusters_per_pass, st.register_budget,
-        st.registers_per_cluster, render::kAccumulationNames.name(st.accumulation));
+        st.registers_per_cluster, render::kAccumulationNames.name(st.accumulation),
+        render::kConstantsNames.name(st.constants));
     std::printf("overdraw    %.4f (%llu triangles, drawn per pass %s)\n", st.average_overdraw,
                 static_cast<unsigned long long>(st.triangle_count),
                 count_list(st.triangles_per_pass).c_str());
@@ -202,6 +205,7 @@ void print_report(const Options& o, const render::RenderStats& st,
     add_work(line, st.pass_work);
     line["supersample"] = o.supersample;
     line["accumulation"] = render::kAccumulationNames.name(st.accumulation);
+    line["constants"] = render::kConstantsNames.name(st.constants);
     line["image_frame_ms"] = image_ms;
     line["downsample_ms"] = downsample_ms;
     std::printf("%s\n", dump_json(line).c_str());

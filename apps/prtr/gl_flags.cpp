@@ -33,6 +33,14 @@ void add_accumulation_flag(CLI::App* cmd, std::string& name) {
       CLI::IsMember(render::kAccumulationNames.names()));
 }
 
+void add_constants_flag(CLI::App* cmd, std::string& name) {
+  add_checked_option(cmd, "--constants", name,
+                     "Where each frame's lighting constants are computed: cpu, gpu (one compute "
+                     "dispatch over the clusters' rows in video memory), or auto (gpu on a "
+                     "hardware GPU, cpu on Mesa's software rasterisers)",
+                     CLI::IsMember(render::kConstantsNames.names()));
+}
+
 render::GlSelection gl_selection(const GlFlags& flags) {
   render::GlSelection s;
   const auto backend = render::parse_gl_backend(flags.backend);

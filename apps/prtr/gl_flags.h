@@ -21,6 +21,9 @@ void add_gl_flags(CLI::App* cmd, GlFlags& flags);
 // --accumulation auto|rgba32f|rgba16f: the colour target's format (render::Accumulation).
 void add_accumulation_flag(CLI::App* cmd, std::string& name);
 
+// --constants auto|cpu|gpu: where the per-frame constants are computed (render::Constants).
+void add_constants_flag(CLI::App* cmd, std::string& name);
+
 // The backend and device the flags name. An EGL device index beyond those EGL lists is a
 // UsageError (exit 2) naming the count; EGL that cannot be loaded at all fails as GlError.
 render::GlSelection gl_selection(const GlFlags& flags);

@@ -3,6 +3,7 @@
 // per-frame constants (render/shading.h) and the per-vertex cluster data; they differ in how
 // clusters are grouped into passes, how the constants are bound and who shades.
 #include "common/check.h"
+#include "gpu_constants.h"
 #include "render/gl_context.h"
 #include "render/pass_capacity.h"
 #include "render/shader_source.h"
@@ -115,7 +116,10 @@ class ClusterPath : public RenderPath {
   // `legacy_sort`: the slot sort this path had before renumbering (renumber_vertices off).
   ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot,
               bool pass_blocks, bool legacy_sort, bool zero_copies = false)
-      : constants_(*in.set), layout_(constants_.layout()) {
+      : constants_(*in.set),
+        layout_(constants_.layout()),
+        wanted_constants_(in.options.constants),
+        stats_(&in.stats) {
     const int per_pass = clusters_per_pass(in);
     plan_ = plan_slots(group(in, per_pass, split), in.set->cluster_count,
                        layout_.registers_per_cluster(), per_cluster_aligned);
@@ -144,6 +148,10 @@ class ClusterPath : public RenderPath {
   ~ClusterPath() override { glDeleteBuffers(1, &constant_buffer_); }
 
   void update(const Eigen::MatrixXd& lit, const Camera&) override {
+    if (gpu_constants_) {
+      gpu_constants_->compute(lit, constant_buffer_);
+      return;
+    }
     constants_.compute(lit, plan_.slot_of, host_.data());
     glBindBuffer(constant_target_, constant_buffer_);
     glBufferSubData(constant_target_, 0, GLsizeiptr(host_.size() * 4), host_.data());
@@ -171,6 +179,17 @@ class ClusterPath : public RenderPath {
     mesh_->upload_indices();
     constant_target_ = target;
     constant_buffer_ = make_buffer(target, GLsizeiptr(host_.size() * 4), nullptr, GL_DYNAMIC_DRAW);
+    if (shaded_on_gpu && constants_on_gpu())
+      gpu_constants_ = std::make_unique<GpuConstants>(constants_, plan_.slot_of, host_.size());
+    stats_->constants = gpu_constants_ ? Constants::kGpu : Constants::kCpu;
+  }
+
+  // kAuto (RendererOptions::constants): a hardware GPU whose storage blocks hold the rows.
+  bool constants_on_gpu() const {
+    if (wanted_constants_ != Constants::kAuto) return wanted_constants_ == Constants::kGpu;
+    const GlInfo info = current_gl_info();
+    return !info.software_rasterizer() &&
+           GpuConstants::row_bytes(constants_) <= std::size_t(std::max(info.max_ssbo_size, 0LL));
   }
 
   // Each vertex's slot (what the single-pass, decoupled and CPU shaders index by).
@@ -230,6 +249,9 @@ class ClusterPath : public RenderPath {
   std::vector<IndexRange> pass_ranges_;
   GLuint constant_buffer_ = 0;
   GLenum constant_target_ = GL_UNIFORM_BUFFER;
+  Constants wanted_constants_;
+  RenderStats* stats_;
+  std::unique_ptr<GpuConstants> gpu_constants_;  // null: computed on the CPU and uploaded
 
  private:
   // Per pass, its triangles' corners in GPU numbering: an own corner is its mesh vertex (GPU

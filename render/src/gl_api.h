@@ -54,6 +54,7 @@
   X(glDepthMask)                 \
   X(glDisable)                   \
   X(glDisableVertexAttribArray)  \
+  X(glDispatchCompute)           \
   X(glDrawArrays)                \
   X(glDrawElements)              \
   X(glEnable)                    \
@@ -82,6 +83,7 @@
   X(glGetString)                 \
   X(glGetUniformLocation)        \
   X(glLinkProgram)               \
+  X(glMemoryBarrier)             \
   X(glPixelStorei)               \
   X(glReadBuffer)                \
   X(glReadPixels)                \
@@ -161,6 +163,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glDepthMask (::render::gl::current->glDepthMask)
 #define glDisable (::render::gl::current->glDisable)
 #define glDisableVertexAttribArray (::render::gl::current->glDisableVertexAttribArray)
+#define glDispatchCompute (::render::gl::current->glDispatchCompute)
 #define glDrawArrays (::render::gl::current->glDrawArrays)
 #define glDrawElements (::render::gl::current->glDrawElements)
 #define glEnable (::render::gl::current->glEnable)
@@ -189,6 +192,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glGetString (::render::gl::current->glGetString)
 #define glGetUniformLocation (::render::gl::current->glGetUniformLocation)
 #define glLinkProgram (::render::gl::current->glLinkProgram)
+#define glMemoryBarrier (::render::gl::current->glMemoryBarrier)
 #define glPixelStorei (::render::gl::current->glPixelStorei)
 #define glReadBuffer (::render::gl::current->glReadBuffer)
 #define glReadPixels (::render::gl::current->glReadPixels)

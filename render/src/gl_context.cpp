@@ -81,6 +81,11 @@ int GlInfo::default_register_budget() const {
   return max_uniform_block_size / 16;
 }
 
+bool GlInfo::software_rasterizer() const {
+  return renderer.find("llvmpipe") != std::string::npos ||
+         renderer.find("softpipe") != std::string::npos;
+}
+
 GlInfo GlContext::info() const {
   return current_gl_info();
 }

@@ -44,7 +44,10 @@ GLuint compile(GLenum stage, const std::string& source, const std::string& name)
     const std::string log = shader_log(shader);
     glDeleteShader(shader);
     throw GlError("GLSL compile error in " + name +
-                  (stage == GL_VERTEX_SHADER ? " (vertex)" : " (fragment)") + ":\n" + log +
+                  (stage == GL_VERTEX_SHADER     ? " (vertex)"
+                   : stage == GL_COMPUTE_SHADER ? " (compute)"
+                                                : " (fragment)") +
+                  ":\n" + log +
                   "source:\n" + excerpt(source, log));
   }
   return shader;
@@ -69,9 +72,19 @@ GlProgram::GlProgram(const std::string& name, const std::string& vertex,
     const char* varyings[] = {"v_radiance"};
     glTransformFeedbackVaryings(id_, 1, varyings, GL_INTERLEAVED_ATTRIBS);
   }
+  link(name, {vs, fs});
+}
+
+GlProgram::GlProgram(const std::string& name, const std::string& compute) {
+  const GLuint cs = compile(GL_COMPUTE_SHADER, compute, name);
+  id_ = glCreateProgram();
+  glAttachShader(id_, cs);
+  link(name, {cs});
+}
+
+void GlProgram::link(const std::string& name, std::initializer_list<GLuint> shaders) {
   glLinkProgram(id_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
+  for (GLuint shader : shaders) glDeleteShader(shader);
   GLint ok = 0;
   glGetProgramiv(id_, GL_LINK_STATUS, &ok);
   if (!ok) {

@@ -4,6 +4,7 @@
 
 #include "gl_api.h"
 
+#include <initializer_list>
 #include <string>
 #include <unordered_map>
 
@@ -16,6 +17,8 @@ class GlProgram {
   // the transform feedback output before linking.
   GlProgram(const std::string& name, const std::string& vertex, const std::string& fragment,
             bool capture_radiance = false);
+  // A compute program.
+  GlProgram(const std::string& name, const std::string& compute);
   ~GlProgram();
   GlProgram(GlProgram&& other) noexcept;
   GlProgram& operator=(GlProgram&& other) noexcept;
@@ -28,6 +31,9 @@ class GlProgram {
   GLint uniform(const char* name);
 
  private:
+  // Links the attached `shaders` and deletes them; GlError with the log on failure.
+  void link(const std::string& name, std::initializer_list<GLuint> shaders);
+
   GLuint id_ = 0;
   std::unordered_map<std::string, GLint> uniforms_;
 };

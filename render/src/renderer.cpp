@@ -76,11 +76,8 @@ RenderStats initial_stats(const meshes::Mesh& mesh) {
 // gain nothing from them.
 Accumulation resolve_accumulation(Accumulation wanted) {
   if (wanted != Accumulation::kAuto) return wanted;
-  const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-  const std::string renderer = name != nullptr ? name : "";
-  const bool software = renderer.find("llvmpipe") != std::string::npos ||
-                        renderer.find("softpipe") != std::string::npos;
-  return software ? Accumulation::kFloat32 : Accumulation::kFloat16;
+  return current_gl_info().software_rasterizer() ? Accumulation::kFloat32
+                                                 : Accumulation::kFloat16;
 }
 
 Renderer::Impl::Impl(const meshes::Mesh& mesh, const cpca::CompressedSet* set,

@@ -60,6 +60,9 @@ struct GlInfo {
   // instead of 16. Every default budget (renderer, pass grouping, benchmark) comes from here,
   // so they cannot disagree.
   int default_register_budget() const;
+  // Mesa's llvmpipe or softpipe: the CPU rasterises, so what is cheap on a GPU (half-float
+  // blending, compute dispatches) may not be here.
+  bool software_rasterizer() const;
 };
 
 // The limits of the context current on this thread (GlContext::info of it).

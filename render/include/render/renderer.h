@@ -69,9 +69,20 @@ inline constexpr auto kAccumulationNames =
 // What `wanted` means in the current GL context (kAuto resolved by its renderer's name).
 Accumulation resolve_accumulation(Accumulation wanted);
 
+// Where the per-frame lighting constants (render/shading.h) are computed for the GPU-shaded
+// paths. On the CPU the products stream every cluster's transfer rows from memory each
+// frame and upload the results; on a GPU one compute dispatch reads the rows from video
+// memory and writes the constant buffer in place. llvmpipe runs that dispatch on the CPU
+// slower than the CPU's own parallel products, so kAuto takes the GPU on hardware only, and
+// only where the rows fit one shader storage block. The CPU-shaded path always uses the CPU.
+enum class Constants { kAuto, kCpu, kGpu };
+inline constexpr auto kConstantsNames = common::enum_table<Constants>(
+    "constants", {{Constants::kAuto, "auto"}, {Constants::kCpu, "cpu"}, {Constants::kGpu, "gpu"}});
+
 struct RendererOptions {
   Mode mode = Mode::kMultipass;
   Accumulation accumulation = Accumulation::kAuto;
+  Constants constants = Constants::kAuto;
   // vec4 registers a pass may use; 0 = what the context offers
   // (GlInfo::default_register_budget).
   int register_budget = 0;
@@ -135,6 +146,7 @@ struct RenderStats {
   std::uint64_t triangle_count = 0;
   std::uint64_t vertex_count = 0;
   Accumulation accumulation = Accumulation::kFloat32;  // as resolved for this context
+  Constants constants = Constants::kCpu;               // as resolved for this path
 };
 
 class Renderer {

@@ -59,6 +59,13 @@ class ShadingConstants {
 
   const ConstantLayout& layout() const { return layout_; }
   int cluster_count() const { return cluster_count_; }
+  int channels() const { return channels_; }
+  int coefficient_count() const { return order_ * order_; }
+  // Cluster k's transfer rows, (N + 1) * channels * rows x n, row-major: term t, channel c,
+  // row i is row (t * channels + c) * rows + i. Its constants are these rows times l.
+  const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& rows(int k) const {
+    return packed_[std::size_t(k)];
+  }
 
   // Writes cluster k's constants to out + slot_of[k] * layout().floats_stride() (padding
   // floats are zeroed). Clusters run in parallel (TBB). `lighting` is n x 3, n = set order^2.
