@@ -28,8 +28,10 @@
 #include <cstdlib>
 #include <ctime>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -43,6 +45,7 @@ double process_cpu_ms() {
 
 struct Sample {
   double overdraw = 0, frame_ms = 0, cpu_ms = 0;  // cpu: process CPU over all threads
+  render::Constants constants = render::Constants::kCpu;  // where the row's were computed
 };
 
 // The speed targets as ratios within this run, by wall clock and by process CPU (the load of
@@ -85,6 +88,7 @@ struct Args {
   int frames = 15, width = 1280, height = 948;
   render::Accumulation accumulation = render::Accumulation::kAuto;
   render::Constants constants = render::Constants::kAuto;
+  bool sweep = false;  // --rows sweep
 };
 
 template <typename Table>
@@ -101,7 +105,8 @@ Args parse_args(int argc, char** argv) {
     throw UsageError(
         "usage: render_bench COMPRESSED.prtc [--transfer T.prtx] [--probe P|procedural] "
         "[--mesh M] [--frames F] [--width W] [--height H] [--gl osmesa|egl] "
-        "[--gl-device N] [--accumulation auto|rgba32f|rgba16f] [--constants auto|cpu|gpu]");
+        "[--gl-device N] [--accumulation auto|rgba32f|rgba16f] [--constants auto|cpu|gpu] "
+        "[--rows main|sweep]");
   Args a;
   a.compressed = argv[1];
   try {
@@ -129,6 +134,10 @@ Args parse_args(int argc, char** argv) {
       a.gl.device = int(n);
     } else if (flag == "--accumulation") {
       a.accumulation = parse_named(render::kAccumulationNames, flag, value);
+    } else if (flag == "--rows") {
+      if (value != "main" && value != "sweep")
+        throw UsageError("--rows " + value + ": use main or sweep");
+      a.sweep = value == "sweep";
     } else if (flag == "--constants") {
       a.constants = parse_named(render::kConstantsNames, flag, value);
     } else if (flag == "--frames") {
@@ -219,10 +228,10 @@ Floors measure_floors(const Scene& s, int frames) {
 }
 
 struct Row {
-  const char* name;
+  std::string name;
   render::Mode mode;
   int clusters_per_pass;
-  const char* strategy = nullptr;  // cpca::group_clusters name; null: cluster order
+  std::string_view strategy = {};  // cpca::group_clusters name; empty: cluster order
 };
 
 // The thesis configuration is the ILS row: 3 clusters per pass grouped by ILS.
@@ -235,20 +244,32 @@ const Row kRows[] = {{"multipass, context budget", render::Mode::kMultipass, 0},
                      {"uncompressed", render::Mode::kUncompressed, 0},
                      {"cpu-shaded", render::Mode::kCpu, 0}};
 
+// --rows sweep: multipass at 3 and 16 clusters a pass under every grouping strategy, the same
+// passes with different overdraw, for FPS against overdraw (the thesis's Fig. 5.x question:
+// does overdraw cost frames?).
+std::vector<Row> sweep_rows() {
+  std::vector<Row> rows;
+  for (int per_pass : {3, 16})
+    for (const cpca::NamedStrategy& strategy : cpca::supercluster_strategies())
+      rows.push_back({"sweep " + std::to_string(per_pass) + "/pass, " + std::string(strategy.name),
+                      render::Mode::kMultipass, per_pass, strategy.name});
+  return rows;
+}
+
 using PassDetails = std::vector<std::pair<std::string, std::vector<render::PassWork>>>;
 
 // One row (feedback: multipass shading by feedback, the default; else in the triangle draws),
 // printed; nullopt when the context cannot run it. Its pass work goes to `details`.
 std::optional<Sample> run_row(const Scene& s, const Args& a, const Floors& floors, const Row& row,
                               bool feedback, PassDetails& details) {
-  const std::string name = std::string(row.name) + (feedback ? "" : ", in-draw");
+  const std::string name = row.name + (feedback ? "" : ", in-draw");
   render::RendererOptions o;
   o.accumulation = a.accumulation;
   o.constants = a.constants;
   o.multipass_feedback = feedback;
   o.mode = row.mode;
   o.clusters_per_pass = row.clusters_per_pass;
-  if (row.strategy) {
+  if (!row.strategy.empty()) {
     std::vector<cpca::TriangleIndices> tris(s.mesh.triangles.begin(), s.mesh.triangles.end());
     o.groups = cpca::group_clusters(
         row.strategy, {s.set.cluster_of, tris, s.set.cluster_count, row.clusters_per_pass});
@@ -280,7 +301,7 @@ std::optional<Sample> run_row(const Scene& s, const Args& a, const Floors& floor
   print_work(mesh_work);
   details.emplace_back(name, r.stats().pass_work);
   std::fflush(stdout);
-  return Sample{r.stats().average_overdraw, t.frame_ms_median, proc_ms};
+  return Sample{r.stats().average_overdraw, t.frame_ms_median, proc_ms, r.stats().constants};
 }
 
 // Per draw, so a path's waste can be traced to the draw that has it; multipass shading
@@ -334,21 +355,30 @@ void run(const Args& a) {
   PassDetails details;
   std::vector<Sample> multipass_3;  // 3 clusters per pass: order, then ILS
   Sample thesis;
+  std::set<std::string_view> used;  // where the GPU-shaded rows' constants were computed
   // Multipass twice: shading by feedback (the default) and in the triangle draws
   // (", in-draw"), so the effect is a ratio within this run.
-  for (const Row& row : kRows)
+  const std::vector<Row> rows =
+      a.sweep ? sweep_rows() : std::vector<Row>(std::begin(kRows), std::end(kRows));
+  for (const Row& row : rows)
     for (bool feedback : {false, true}) {
-      if (!feedback && row.mode != render::Mode::kMultipass) continue;
+      if (!feedback && (a.sweep || row.mode != render::Mode::kMultipass)) continue;
       if (row.mode == render::Mode::kUncompressed && !s.transfer) {
-        std::printf("%-28s (skipped: pass --transfer)\n", row.name);
+        std::printf("%-28s (skipped: pass --transfer)\n", row.name.c_str());
         continue;
       }
       const std::optional<Sample> sample = run_row(s, a, floors, row, feedback, details);
       if (!sample) continue;
       if (feedback && row.mode == render::Mode::kMultipass && row.clusters_per_pass == 3)
         multipass_3.push_back(*sample);
-      if (feedback && row.strategy) thesis = *sample;
+      if (feedback && !row.strategy.empty()) thesis = *sample;
+      if (row.mode != render::Mode::kCpu)
+        used.insert(render::kConstantsNames.name(sample->constants));
     }
+  std::string list;
+  for (std::string_view u : used) list += (list.empty() ? "" : ", ") + std::string(u);
+  std::printf("render_bench: the GPU-shaded rows' constants computed on the %s\n", list.c_str());
+  if (a.sweep) return;
   print_targets(multipass_3, thesis, {1.0, floors.ms, floors.cpu_ms}, floors.background_ms);
   print_details(details);
 }

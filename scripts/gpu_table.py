@@ -63,6 +63,52 @@ def render_tables(log):
     return "\n".join(out)
 
 
+def fit(xs, ys):
+    """Least-squares y = a + b x: (a, b, R^2); None with fewer than 3 points or no spread."""
+    n = len(xs)
+    if n < 3:
+        return None
+    mx, my = sum(xs) / n, sum(ys) / n
+    sxx = sum((x - mx) ** 2 for x in xs)
+    syy = sum((y - my) ** 2 for y in ys)
+    if sxx == 0:
+        return None
+    b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sxx
+    a = my - b * mx
+    r2 = 1.0 - sum((y - a - b * x) ** 2 for x, y in zip(xs, ys)) / syy if syy > 0 else 1.0
+    return a, b, r2
+
+
+def overdraw_fits(log):
+    """Frame time against average overdraw over each sweep's rows (same passes, different
+    groupings), per mesh and clusters per pass."""
+    out = ["| mesh | clusters/pass | rows | overdraw | FPS | frame ms = a + b x overdraw | "
+           "R^2 |", "| --- | ---: | ---: | --- | --- | --- | ---: |"]
+    label = None
+    groups = {}
+    for line in log.splitlines():
+        if line.startswith("== bunny"):
+            label = line.split()[1]
+        elif label and label.endswith("-sweep") and line.startswith("sweep "):
+            m = ROW.match(line)
+            if not m:
+                continue
+            f = line[m.end(1):].split()
+            per_pass = m.group(1).split()[1].split("/")[0]
+            groups.setdefault((label[:-len("-sweep")], per_pass), []).append(
+                (float(f[1]), float(f[3]), float(f[2])))
+    if not groups:
+        return ""
+    for (mesh, per_pass), pts in groups.items():
+        xs, ys, fps = [p[0] for p in pts], [p[1] for p in pts], [p[2] for p in pts]
+        r = fit(xs, ys)
+        line = (f"| {mesh} | {per_pass} | {len(pts)} | {min(xs):.3f}-{max(xs):.3f} | "
+                f"{min(fps):.0f}-{max(fps):.0f} | ")
+        line += f"{r[0]:.3f} + {r[1]:.3f} x | {r[2]:.2f} |" if r else "- | - |"
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
 def bake_table(log):
     runs, cur = [], None
     for line in log.splitlines():
@@ -82,14 +128,15 @@ def bake_table(log):
         elif line.startswith("bare occlusion"):
             cur["bare"] = re.search(r"bare occlusion: ([\d.]+) s", line).group(1)
     one = next((float(r["b1"][0]) for r in runs if r["threads"] == 1 and r["b1"]), None)
-    out = ["| threads | bake, 1 bounce (s) | shadow (s) | bounce (s) | speed-up vs 1 thread | "
-           "bake, 0 bounces (s) | bare Embree occlusion (s) | note |",
-           "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
+    out = ["| threads | bake, 1 bounce (s) | shadow (s) | bounce (s) | rest (s) | "
+           "speed-up vs 1 thread | bake, 0 bounces (s) | bare Embree occlusion (s) | note |",
+           "| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
     for r in sorted(runs, key=lambda r: r["threads"]):
         b1 = r["b1"] or ["-", "-", "-"]
         b0 = r["b0"] or ["-"]
         up = f"{one / float(b1[0]):.2f}" if one and r["b1"] else "-"
-        out.append(f"| {r['threads']} | {b1[0]} | {b1[1]} | {b1[2]} | {up} | {b0[0]} | "
+        rest = (f"{float(b1[0]) - float(b1[1]) - float(b1[2]):.2f}" if r["b1"] else "-")
+        out.append(f"| {r['threads']} | {b1[0]} | {b1[1]} | {b1[2]} | {rest} | {up} | {b0[0]} | "
                    f"{r['bare'] or '-'} | {r['note']} |")
     return "\n".join(out)
 
@@ -105,6 +152,10 @@ def main():
             print(f"- {line}")
     print("\n## render_bench (1280 x 948, median frame)\n")
     print(render_tables(render))
+    fits = overdraw_fits(render)
+    if fits:
+        print("## FPS against overdraw (the sweeps: same passes, every grouping strategy)\n")
+        print(fits)
     print("## bake_bench (bunny, glossy order 6)\n")
     print(bake_table(bake))
 
