@@ -33,6 +33,12 @@ for bin in "$stage"/bin/*; do
 done | sort -u | while read -r name path; do
   [[ $name =~ $skip ]] || cp -L "$path" "$stage/lib/$name"
 done
+# glvnd's dispatcher, for a machine whose driver brings its EGL vendor library
+# (libEGL_nvidia) but not libEGL.so.1 itself; run_gpu.sh uses it only where the system has none.
+mkdir -p "$stage/lib/glvnd"
+for name in libEGL.so.1 libGLdispatch.so.0 libOpenGL.so.0; do
+  cp -L "/usr/lib/x86_64-linux-gnu/$name" "$stage/lib/glvnd/$name"
+done
 if ldd build/bench/render_bench_portable | grep -Eq 'OpenImageIO|OSMesa|embree'; then
   echo "gpu_bundle: render_bench_portable links OpenImageIO, OSMesa or Embree" >&2
   exit 1

@@ -26,6 +26,12 @@ unpack() {  # xz where installed, else Python's lzma (a minimal image may lack x
 }
 unpack || { echo "run_gpu: cannot unpack $bundle/bundle.tar.xz" >&2; exit 1; }
 export LD_LIBRARY_PATH="$here/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+# A driver without glvnd's libEGL.so.1 (its vendor library alone): the bundle's dispatcher.
+glvnd_note="system"
+if ! /sbin/ldconfig -p 2>/dev/null | grep -q 'libEGL.so.1 '; then
+  export LD_LIBRARY_PATH="$here/lib/glvnd:$LD_LIBRARY_PATH"
+  glvnd_note="bundled (the system has no libEGL.so.1)"
+fi
 # glvnd finds NVIDIA's EGL vendor through this file where the driver is mounted outside /usr.
 nv_json=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
 if [[ -z ${__EGL_VENDOR_LIBRARY_FILENAMES:-} && -f $nv_json &&
@@ -47,7 +53,7 @@ rounds=${PRTR_GPU_ROUNDS:-2}
     sed 's/^/gpu: /'
   grep -m1 'model name' /proc/cpuinfo | sed 's/.*: /cpu: /'
   echo "gl: $gl; frames: $frames; bake samples: $samples"
-  echo "egl vendor files: ${__EGL_VENDOR_LIBRARY_FILENAMES:-default}"
+  echo "egl vendor files: ${__EGL_VENDOR_LIBRARY_FILENAMES:-default}; glvnd: $glvnd_note"
   ldd "$here/bin/render_bench_portable" | grep -E 'not found|libEGL' || true
 } >"$res/env.txt" 2>&1
 cat "$res/env.txt"

@@ -18,6 +18,11 @@ inline constexpr std::uint64_t kChunk = 64;  // vertices per scheduling unit (an
 // The vertices a pass computes, in the order their rows are written.
 using VertexList = std::span<const std::uint32_t>;
 
+// Faults in the whole pages of [start, start + bytes) from the worker threads (Linux's
+// MADV_POPULATE_WRITE; a no-op where the kernel lacks it), so that a large fresh allocation's
+// first writes on one thread run at memory bandwidth instead of one page fault per page.
+void populate_pages(void* start, std::size_t bytes);
+
 // The vertices [begin, end) in index order.
 std::vector<std::uint32_t> index_range(std::uint64_t begin, std::uint64_t end);
 

@@ -248,14 +248,16 @@ Mode Renderer::mode() const {
 TimingSummary measure(Renderer& renderer, const Camera& camera,
                       const Eigen::Ref<const prt::ShLighting>& lighting,
                       const Eigen::Matrix3d& start_rotation, const Eigen::Vector3d& axis,
-                      double degrees_per_frame, int frames, int warmup) {
+                      double degrees_per_frame, int frames, int warmup, double warmup_ms) {
   if (frames < 1) throw std::invalid_argument("--frames must be >= 1");
   std::vector<double> total, cpu, gl;
+  const auto warmup_start = Clock::now();
   for (int f = -warmup; f < frames; ++f) {
     const Eigen::Matrix3d r = prt::axis_angle(axis.normalized(), degrees_per_frame * (f + warmup) *
                                                                      std::numbers::pi / 180.0) *
                               start_rotation;
     const FrameTiming t = renderer.render(camera, lighting, r);
+    if (f == -1 && ms_since(warmup_start) < warmup_ms) --f;  // the warm-up's last frame again
     if (f < 0) continue;
     total.push_back(t.total_ms);
     cpu.push_back(t.cpu_ms);

@@ -197,7 +197,10 @@ class Renderer {
 
 // The median-of-frames measurement (docs/ARCHITECTURE.md "Rendering", Timing): `warmup` frames,
 // then `frames` frames, each with the environment rotated by `degrees_per_frame` more about `axis`
-// (so constants are recomputed every frame, inside the timing), each ended by glFinish.
+// (so constants are recomputed every frame, inside the timing), each ended by glFinish. The
+// warm-up lasts at least `warmup_ms`: a GPU left idle during set-up (a grouping search) runs
+// its first tens of milliseconds of frames at idle clocks, which a median of a few fast frames
+// would take for the configuration's speed (docs/BENCHMARKS.md, "On a GPU").
 struct TimingSummary {
   int frames = 0;
   double frame_ms_median = 0, cpu_ms_median = 0, gl_ms_median = 0;
@@ -206,6 +209,7 @@ struct TimingSummary {
 TimingSummary measure(Renderer& renderer, const Camera& camera,
                       const Eigen::Ref<const prt::ShLighting>& lighting,
                       const Eigen::Matrix3d& start_rotation, const Eigen::Vector3d& axis,
-                      double degrees_per_frame, int frames, int warmup);
+                      double degrees_per_frame, int frames, int warmup,
+                      double warmup_ms = 0);
 
 }  // namespace render
