@@ -22,7 +22,8 @@
 namespace prtr_app {
 using common::dump_json;
 using common::Json;
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_bake {
 
 // "k/n" as {k, n}; {0, 0} for no shard.
 std::pair<std::uint32_t, std::uint32_t> parse_shard(const std::string& text) {
@@ -151,9 +152,10 @@ void print_summary(const std::string& mesh_path, const std::string& output,
       100.0 * prt::kNearlyOccluded, id_list(dark).c_str(), moved.size(), id_list(moved).c_str());
 }
 
-}  // namespace
+}  // namespace cmd_bake
 
 Runner add_bake_command(CLI::App& app) {
+  using namespace cmd_bake;
   struct Options {
     std::string mesh, output;
     BakeFlags flags;

@@ -23,7 +23,8 @@
 namespace prtr_app {
 using common::dump_json;
 using common::Json;
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_compress {
 
 struct Options {
   std::string transfer, mesh, output;
@@ -183,9 +184,10 @@ void mpi_compress(const Options& o, const cpca::CompressOptions& options) {
   mpi_barrier();
 }
 
-}  // namespace
+}  // namespace cmd_compress
 
 Runner add_compress_command(CLI::App& app) {
+  using namespace cmd_compress;
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "compress", "Compress a bake with clustered PCA (CPCA) into a .prtc file for rendering");

@@ -19,7 +19,8 @@
 #include <string>
 
 namespace prtr_app {
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_info {
 
 enum class FileKind { kTransfer, kCompressed };
 
@@ -142,9 +143,10 @@ void describe_compressed(const std::string& path, const std::string& mesh,
   if (!stale.empty()) throw std::runtime_error(stale);
 }
 
-}  // namespace
+}  // namespace cmd_info
 
 Runner add_info_command(CLI::App& app) {
+  using namespace cmd_info;
   struct Options {
     std::string path, mesh, transfer;
     bool verify = false;

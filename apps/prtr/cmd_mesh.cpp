@@ -14,7 +14,8 @@
 
 namespace prtr_app {
 
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_mesh {
 
 // What the file held, what loading cleaned up, and the result every later stage sees.
 void print_report(const meshes::LoadReport& report, const meshes::Mesh& mesh) {
@@ -46,9 +47,10 @@ void print_report(const meshes::LoadReport& report, const meshes::Mesh& mesh) {
   std::printf("hash        %016llx\n", static_cast<unsigned long long>(meshes::content_hash(mesh)));
 }
 
-}  // namespace
+}  // namespace cmd_mesh
 
 Runner add_mesh_command(CLI::App& app) {
+  using namespace cmd_mesh;
   struct Options {
     std::string path;
     double weld = meshes::LoadOptions{}.weld_tolerance;

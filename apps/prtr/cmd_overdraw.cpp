@@ -29,7 +29,8 @@
 #include <vector>
 
 namespace prtr_app {
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_overdraw {
 
 using overdraw::OverdrawPlan;
 using overdraw::OverdrawReport;
@@ -258,10 +259,10 @@ constexpr const char* kAbout =
     "Overdraw benchmark (thesis tables 5.2-5.17): methods x strategies x budgets -> clustering "
     "time, average overdraw, FPS, Average SE, image RMSE; Markdown, CSV, JSON, plot, pictures";
 
-}  // namespace
+}  // namespace cmd_overdraw
 
 Runner add_overdraw_command(CLI::App& app) {
-  return add_command<Options>(app, "overdraw", kAbout, add_flags, run);
+  return add_command<cmd_overdraw::Options>(app, "overdraw", cmd_overdraw::kAbout, cmd_overdraw::add_flags, cmd_overdraw::run);
 }
 
 }  // namespace prtr_app

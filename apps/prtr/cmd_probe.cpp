@@ -13,7 +13,8 @@
 
 namespace prtr_app {
 
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_probe {
 
 void print_coefficients(const prt::ShLighting& sh, int order) {
   std::printf("%4s %4s %14s %14s %14s\n", "l", "m", "R", "G", "B");
@@ -50,9 +51,10 @@ void print_report(const probes::LoadReport& report, const probes::Probe& probe,
   }
 }
 
-}  // namespace
+}  // namespace cmd_probe
 
 Runner add_probe_command(CLI::App& app) {
+  using namespace cmd_probe;
   struct Options {
     std::string path;
     int order = 6;

@@ -43,7 +43,8 @@
 
 namespace prtr_app {
 namespace fs = std::filesystem;
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_relight {
 
 std::string frame_name(int index, const char* extension) {
   char buf[32];
@@ -337,10 +338,10 @@ constexpr const char* kAbout =
     "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
     "previews, a contact sheet, an animated GIF and an MP4 (ffmpeg)";
 
-}  // namespace
+}  // namespace cmd_relight
 
 Runner add_relight_command(CLI::App& app) {
-  return add_command<Options>(app, "relight", kAbout, add_flags, run);
+  return add_command<cmd_relight::Options>(app, "relight", cmd_relight::kAbout, cmd_relight::add_flags, cmd_relight::run);
 }
 
 }  // namespace prtr_app

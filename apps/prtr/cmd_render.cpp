@@ -35,7 +35,8 @@
 namespace prtr_app {
 using common::dump_json;
 using common::Json;
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_render {
 
 // "[a,b,c]": the per-pass triangle counts, as the text report and error messages show them.
 std::string count_list(const std::vector<std::uint64_t>& values) {
@@ -271,10 +272,10 @@ void run(const Options& o, CLI::App* cmd) {
 constexpr const char* kAbout =
     "Relight a compressed bake (.prtc) under a rotated probe; write EXR/PNG and FPS";
 
-}  // namespace
+}  // namespace cmd_render
 
 Runner add_render_command(CLI::App& app) {
-  return add_command<Options>(app, "render", kAbout, add_flags, run);
+  return add_command<cmd_render::Options>(app, "render", cmd_render::kAbout, cmd_render::add_flags, cmd_render::run);
 }
 
 }  // namespace prtr_app

@@ -28,7 +28,8 @@
 namespace prtr_app {
 using common::Json;
 namespace fs = std::filesystem;
-namespace {
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_view {
 
 using viewer::SceneInfo;
 using viewer::ServedInfo;
@@ -209,10 +210,10 @@ constexpr const char* kAbout =
     "Bake, compress (cached) and serve MESH under PROBE to a browser: drag to relight, with "
     "render modes, probes, overlays and live statistics";
 
-}  // namespace
+}  // namespace cmd_view
 
 Runner add_view_command(CLI::App& app) {
-  return add_command<Options>(app, "view", kAbout, add_flags, run);
+  return add_command<cmd_view::Options>(app, "view", cmd_view::kAbout, cmd_view::add_flags, cmd_view::run);
 }
 
 }  // namespace prtr_app

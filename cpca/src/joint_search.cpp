@@ -20,7 +20,7 @@
 namespace cpca {
 namespace {
 
-double sum(const std::vector<double>& v) {
+double total_of(const std::vector<double>& v) {
   return std::accumulate(v.begin(), v.end(), 0.0);
 }
 
@@ -223,8 +223,8 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
     PRTR_DCHECK(triangles_drawn(inc, next_pass) == drawn);
     drawn = swap_descent(inc, o.per_pass, next_pass, swaps);
   }
-  const double before = sum(error) + mu * double(r.triangles_drawn);
-  const double after = sum(next_error) + mu * double(drawn);
+  const double before = total_of(error) + mu * double(r.triangles_drawn);
+  const double after = total_of(next_error) + mu * double(drawn);
   if (!(after < before)) return false;
   set = std::move(next);
   error = std::move(next_error);
@@ -332,7 +332,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
     throw std::invalid_argument("joint search: the overdraw cap must be 0 (none) or >= 1, got " +
                                 std::to_string(options.overdraw_cap));
   JointSearchResult r;
-  const double total = sum(vertex_error);
+  const double total = total_of(vertex_error);
   r.error_scale = total / double(data.rows());
   const ClusterIncidence inc = incidence_of(set, geometry, options.per_pass);
   r.triangles_drawn = triangles_drawn(inc, pass_of);
@@ -345,7 +345,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
   }
   const VertexTriangles vt(std::size_t(data.rows()), geometry.triangles);
   const Eigen::VectorXf norms = data.rowwise().squaredNorm();
-  for (int i = 1; i <= options.max_steps && sum(vertex_error) > 0; ++i) {
+  for (int i = 1; i <= options.max_steps && total_of(vertex_error) > 0; ++i) {
     r.tried = i;
     if (!step(data, geometry, vt, norms, options, mu, set, vertex_error, pass_of, r)) break;
   }

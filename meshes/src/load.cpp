@@ -64,7 +64,7 @@ std::string supported_list() {
   return out;
 }
 
-std::string describe(const Vec3& v) {
+std::string describe_point(const Vec3& v) {
   std::ostringstream out;
   out << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
   return out.str();
@@ -582,7 +582,7 @@ void check_parsed(const CollectingImporter& importer, const std::string& format,
     if (!importer.positions[v].allFinite()) {
       throw fail("vertex " + std::to_string(v) +
                  " (0-based, in file order) has a non-finite coordinate " +
-                 describe(importer.positions[v]) + "; fix or remove it");
+                 describe_point(importer.positions[v]) + "; fix or remove it");
     }
   }
 }

@@ -39,7 +39,7 @@ struct CellHash {
 };
 
 // Adding +0 turns -0 into +0, so equal floats have equal bits.
-std::int64_t bits_of(float x) {
+std::int64_t cell_bits(float x) {
   return std::bit_cast<std::int32_t>(x + 0.f);
 }
 
@@ -52,7 +52,7 @@ PositionGroups group_equal_positions(const std::vector<Vec3>& positions) {
   group_of.reserve(positions.size());
   for (std::size_t v = 0; v < positions.size(); ++v) {
     const Vec3& p = positions[v];
-    const CellKey key{bits_of(p.x()), bits_of(p.y()), bits_of(p.z())};
+    const CellKey key{cell_bits(p.x()), cell_bits(p.y()), cell_bits(p.z())};
     const auto [it, fresh] = group_of.try_emplace(key, std::uint32_t(out.first.size()));
     if (fresh) out.first.push_back(std::uint32_t(v));
     out.group[v] = it->second;

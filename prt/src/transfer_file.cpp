@@ -8,6 +8,8 @@
 // element, because a bunny bake is ~180 MB.
 #include "prt/transfer_file.h"
 
+#include "prt/sh.h"
+
 #include "common/atomic_file.h"
 #include "common/binary_file.h"
 #include "common/hash.h"
@@ -73,7 +75,6 @@ constexpr std::size_t kOffHeaderChecksum = 120;   // u64, FNV-1a of bytes [0, 12
 static_assert(kOffHeaderChecksum + 8 == kHeaderBytes);
 
 // --- Ranges ------------------------------------------------------------------------------------
-constexpr std::int64_t kMaxOrder = 10;
 constexpr std::int64_t kMaxBounces = 16;
 constexpr std::uint64_t kMaxVertexCount = std::uint64_t(1) << 40;
 constexpr float kMaxExponent = 10000.f;

@@ -26,11 +26,11 @@ constexpr std::size_t kOffIndex = 16;            // u32
 constexpr std::size_t kOffCount = 20;            // u32
 constexpr std::size_t kOffFirst = 24;            // u64
 constexpr std::size_t kOffEnd = 32;              // u64
-constexpr std::size_t kOffPayloadFloats = 40;    // u64
-constexpr std::size_t kOffPayloadChecksum = 48;  // u64
+constexpr std::size_t kShardPayloadFloats = 40;    // u64
+constexpr std::size_t kShardPayloadChecksum = 48;  // u64
 constexpr std::size_t kPrefixBytes = common::kVersionedHeaderBytes + kTransferHeaderBytes;
 
-constexpr common::VersionedFormat kFormat{"transfer shard",
+constexpr common::VersionedFormat kShardFormat{"transfer shard",
                                           "shard written by prtr bake --shard",
                                           "create it with prtr bake --shard k/n",
                                           "bake that shard again with prtr bake --shard",
@@ -51,9 +51,9 @@ TransferFileError error(const std::string& message) {
 
 Shard open_shard(const fs::path& path) {
   const std::string name = path.string();
-  common::OpenedVersionedFile opened = common::open_versioned(path, kFormat);
+  common::OpenedVersionedFile opened = common::open_versioned(path, kShardFormat);
   if (!opened.problem.empty()) throw error(name + ": " + opened.problem);
-  if (const std::string p = common::header_checksum_problem(opened.header, kFormat); !p.empty())
+  if (const std::string p = common::header_checksum_problem(opened.header, kShardFormat); !p.empty())
     throw error(name + ": " + p);
   Shard s;
   s.path = path;
@@ -61,11 +61,11 @@ Shard open_shard(const fs::path& path) {
   s.range.count = common::get_field<std::uint32_t>(opened.header, kOffCount);
   s.range.first = common::get_field<std::uint64_t>(opened.header, kOffFirst);
   s.range.end = common::get_field<std::uint64_t>(opened.header, kOffEnd);
-  s.floats = common::get_field<std::uint64_t>(opened.header, kOffPayloadFloats);
-  s.checksum = common::get_field<std::uint64_t>(opened.header, kOffPayloadChecksum);
+  s.floats = common::get_field<std::uint64_t>(opened.header, kShardPayloadFloats);
+  s.checksum = common::get_field<std::uint64_t>(opened.header, kShardPayloadChecksum);
   opened.stream.read(reinterpret_cast<char*>(s.transfer_header.data()), kTransferHeaderBytes);
   if (opened.stream.gcount() != std::streamsize(kTransferHeaderBytes))
-    throw error(name + ": truncated before its transfer header; " + kFormat.remedy);
+    throw error(name + ": truncated before its transfer header; " + kShardFormat.remedy);
   s.shape = decode_transfer_header(s.transfer_header, name);
   const ShardRange expected = shard_range(s.shape.vertex_count, s.range.index, s.range.count);
   if (s.range.count == 0 || s.range.index >= s.range.count || s.range.first != expected.first ||
@@ -75,10 +75,10 @@ Shard open_shard(const fs::path& path) {
                 std::to_string(s.range.count) + " records vertices [" +
                 std::to_string(s.range.first) + ", " + std::to_string(s.range.end) + ") and " +
                 std::to_string(s.floats) + " floats, which do not fit a bake of " +
-                std::to_string(s.shape.vertex_count) + " vertices; " + kFormat.remedy);
+                std::to_string(s.shape.vertex_count) + " vertices; " + kShardFormat.remedy);
   }
   if (const std::string p =
-          common::file_size_problem(kPrefixBytes + 4 * s.floats, opened.size, kFormat);
+          common::file_size_problem(kPrefixBytes + 4 * s.floats, opened.size, kShardFormat);
       !p.empty())
     throw error(name + ": " + p);
   return s;
@@ -190,13 +190,13 @@ void TransferShardWriter::append(const float* data, std::size_t floats) {
 void TransferShardWriter::commit() {
   if (written_ != expected_)
     throw std::invalid_argument(file_->target().string() + ": the shard is incomplete");
-  common::VersionedHeader h = common::begin_header(kFormat);
+  common::VersionedHeader h = common::begin_header(kShardFormat);
   common::put_field<std::uint32_t>(h, kOffIndex, range_.index);
   common::put_field<std::uint32_t>(h, kOffCount, range_.count);
   common::put_field<std::uint64_t>(h, kOffFirst, range_.first);
   common::put_field<std::uint64_t>(h, kOffEnd, range_.end);
-  common::put_field<std::uint64_t>(h, kOffPayloadFloats, expected_);
-  common::put_field<std::uint64_t>(h, kOffPayloadChecksum, hash_);
+  common::put_field<std::uint64_t>(h, kShardPayloadFloats, expected_);
+  common::put_field<std::uint64_t>(h, kShardPayloadChecksum, hash_);
   common::seal_header(h);
   std::array<unsigned char, kPrefixBytes> prefix{};
   std::memcpy(prefix.data(), h.data(), h.size());
@@ -234,7 +234,7 @@ void merge_shards(const std::vector<fs::path>& paths, const fs::path& output) {
       throw;
     }
     ::close(fd);
-    if (const std::string p = common::checksum_problem("payload", hash, s.checksum, kFormat);
+    if (const std::string p = common::checksum_problem("payload", hash, s.checksum, kShardFormat);
         !p.empty())
       throw error(s.path.string() + ": " + p);
   }

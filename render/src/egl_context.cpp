@@ -99,7 +99,7 @@ struct EglApi {
   }
 };
 
-EglApi& api() {
+EglApi& egl_api() {
   static EglApi instance;  // throws on every call while libEGL cannot be used
   return instance;
 }
@@ -110,7 +110,7 @@ bool is_software(const EglApi& egl, EGLDeviceEXT device) {
 
 class EglContext final : public BackendContext {
  public:
-  EglContext(int device, int major, int minor) : api_(api()) {
+  EglContext(int device, int major, int minor) : api_(egl_api()) {
     const std::vector<EGLDeviceEXT> devices = api_.devices();
     if (devices.empty()) throw GlError("EGL lists no devices");
     if (device >= int(devices.size()))
@@ -180,7 +180,7 @@ class EglContext final : public BackendContext {
                     hex(api_.get_error()) + ")");
     std::call_once(api_.functions_loaded, [&] {
       const auto missing = gl::load(api_.functions, [](const char* name) -> gl::Proc {
-        return reinterpret_cast<gl::Proc>(api().get_proc(name));
+        return reinterpret_cast<gl::Proc>(egl_api().get_proc(name));
       });
       if (!missing.empty()) throw GlError("EGL does not provide " + missing.front());
     });
@@ -207,7 +207,7 @@ std::unique_ptr<BackendContext> make_egl_context(int device, int major, int mino
 }
 
 std::vector<EglDevice> list_egl_devices() {
-  const EglApi& egl = api();
+  const EglApi& egl = egl_api();
   std::vector<EglDevice> out;
   const std::vector<EGLDeviceEXT> devices = egl.devices();
   for (std::size_t i = 0; i < devices.size(); ++i) {

@@ -32,14 +32,14 @@ struct OsmesaApi {
   }
 };
 
-OsmesaApi& api() {
+OsmesaApi& osmesa_api() {
   static OsmesaApi instance;  // throws on every call while the library cannot be loaded
   return instance;
 }
 
 class OsmesaContext final : public BackendContext {
  public:
-  OsmesaContext(int major, int minor, int width, int height) : api_(api()) {
+  OsmesaContext(int major, int minor, int width, int height) : api_(osmesa_api()) {
     const int attribs[] = {OSMESA_FORMAT,
                            OSMESA_RGBA,
                            OSMESA_DEPTH_BITS,
@@ -76,7 +76,7 @@ class OsmesaContext final : public BackendContext {
     // resolved once a context is current, as some loaders require.
     std::call_once(api_.functions_loaded, [&] {
       const auto missing = gl::load(api_.functions, [](const char* name) -> gl::Proc {
-        return reinterpret_cast<gl::Proc>(api().get_proc(name));
+        return reinterpret_cast<gl::Proc>(osmesa_api().get_proc(name));
       });
       if (!missing.empty()) throw GlError("OSMesa does not provide " + missing.front());
     });

@@ -38,14 +38,6 @@ constexpr std::size_t kRenderersKept = 3;
 constexpr std::size_t kProbesKept = 2;        // texels for uploads; SH lighting is kept for all
 constexpr double kDifferenceFullScale = 0.1;  // the difference view's red: 10 % or more
 
-struct CachedRenderer {
-  std::string key;
-  std::shared_ptr<const cpca::CompressedSet> set;  // kept alive while its renderer is
-  std::unique_ptr<render::Renderer> renderer;
-  std::vector<std::uint8_t> pass_counts;  // per triangle, for the overdraw overlay
-  int probe = -1;                         // the probe its background texture holds
-};
-
 std::string renderer_key(const ViewState& s, const cpca::CompressedSet& set) {
   const bool grouped = s.mode == render::Mode::kMultipass || s.mode == render::Mode::kDecoupled;
   return std::string(render::kModeNames.name(s.mode)) + "/" + (grouped ? s.strategy : "-") + "/" +
@@ -54,6 +46,16 @@ std::string renderer_key(const ViewState& s, const cpca::CompressedSet& set) {
 }
 
 }  // namespace
+
+// Outside the anonymous namespace: Impl holds a list of them, and a class with a member of
+// internal-linkage type is an error-prone mix (GCC warns once the file is in a unity unit).
+struct CachedRenderer {
+  std::string key;
+  std::shared_ptr<const cpca::CompressedSet> set;  // kept alive while its renderer is
+  std::unique_ptr<render::Renderer> renderer;
+  std::vector<std::uint8_t> pass_counts;  // per triangle, for the overdraw overlay
+  int probe = -1;                         // the probe its background texture holds
+};
 
 struct ViewScene::Impl {
   explicit Impl(SceneInputs in) : inputs(std::move(in)) {}

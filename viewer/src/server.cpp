@@ -23,7 +23,7 @@ using common::Json;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point start) {
+double elapsed_ms(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
@@ -84,7 +84,7 @@ void send_frame(const FramePtr& frame, httplib::Response& res) {
       composite_overlay(rgb, frame->image.width, frame->image.height, *frame->overlay,
                         frame->overlay_opacity);
     frame->jpeg = encode_jpeg(rgb, frame->image.width, frame->image.height);
-    frame->encode_ms = ms_since(start);
+    frame->encode_ms = elapsed_ms(start);
   });
   res.set_header("Cache-Control", "no-store");
   res.set_header("X-Prtr-Frame", dump_json(frame_header(*frame)));
@@ -185,7 +185,7 @@ int bind(httplib::Server& server, const ServerOptions& options) {
 // The render loop: one job at a time until the queue stops.
 void render_jobs(ViewScene& scene, FrameQueue& queue) {
   while (std::optional<FrameQueue::Job> job = queue.take()) {
-    const double queued = ms_since(job->submitted);
+    const double queued = elapsed_ms(job->submitted);
     std::shared_ptr<RenderedFrame> frame = scene.render(job->state);
     frame->stats.queue_ms = queued;
     frame->stats.requests = job->requests;
