@@ -605,6 +605,39 @@ TEST(Renderer, SetProbeReplacesTheBackground) {
   }
 }
 
+// The probe background replaces the colour clear, so every pixel of a frame must be written by
+// the background or by the mesh over it: a frame after one from another viewpoint (the mesh
+// elsewhere on screen, a different rotation) equals the same frame from a fresh renderer,
+// in every mode, bit for bit.
+TEST(Renderer, ProbeBackgroundLeavesNothingOfTheLastFrame) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_sphere(1.f, 16, 8), 3, 8, 2);
+  const int registers = render::constant_layout(s.set).registers_per_cluster();
+  render::Camera before = s.camera;  // the sphere in a corner, seen from elsewhere
+  before.target += 0.6 * Eigen::Vector3d(1.0, 0.8, 0.0);
+  before.eye += Eigen::Vector3d(0.4, 0.8, 0.0);
+  for (render::Mode mode : {render::Mode::kMultipass, render::Mode::kSinglepass,
+                            render::Mode::kDecoupled, render::Mode::kCpu}) {
+    const render::RendererOptions o = options(mode, 3 * registers);
+    render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, o);
+    r.render(before, s.lighting, Eigen::Matrix3d::Identity());
+    const render::Image first = r.read_image();
+    r.render(s.camera, s.lighting, test_rotation());
+    const render::Image second = r.read_image();
+    const render::Image fresh = render_once(ctx, s, o, s.camera, test_rotation());
+    // The test can tell: pixels the mesh covered first are background now, and the reverse.
+    int uncovered = 0, covered = 0;
+    for (int y = 0; y < fresh.height; ++y)
+      for (int x = 0; x < fresh.width; ++x) {
+        uncovered += first.pixel(x, y)[3] == 1.f && fresh.pixel(x, y)[3] == 0.f;
+        covered += first.pixel(x, y)[3] == 0.f && fresh.pixel(x, y)[3] == 1.f;
+      }
+    ASSERT_GT(uncovered, 50) << render::kModeNames.name(mode);
+    ASSERT_GT(covered, 50) << render::kModeNames.name(mode);
+    EXPECT_EQ(max_abs_difference(second, fresh), 0.0) << render::kModeNames.name(mode);
+  }
+}
+
 // Magnified texels of a checkerboard probe: the image follows the B-spline, and so is not
 // the bilinear lookup (which the smooth test probe above cannot tell apart).
 TEST(Renderer, MagnifiedBackgroundIsBsplineNotBilinear) {

@@ -103,9 +103,15 @@ BackgroundPass::~BackgroundPass() {
 void BackgroundPass::draw(const Camera& camera, const Eigen::Matrix3d& rotation) {
   glBindVertexArray(vao_);
   program_.use();
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_FALSE);
-  glDepthFunc(GL_LEQUAL);
+  // Opaque over the whole target: llvmpipe then shades whole tiles without depth reads,
+  // masks or read-modify-writes, and the pass replaces the RGBA32F colour clear. Measured
+  // against the depth-tested pass after the mesh (only uncovered pixels, alpha masked),
+  // this is cheaper on the bunny frame although it shades the covered pixels too
+  // (docs/BENCHMARKS.md "### Background").
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDisable(GL_DEPTH_TEST);
   glDepthMask(GL_FALSE);
+  glDisable(GL_BLEND);
   glDisable(GL_CULL_FACE);
   // The world ray is affine in screen position, so the corners' rays interpolate exactly.
   const glm::dvec3 f = glm::normalize(to_glm(camera.target) - to_glm(camera.eye));

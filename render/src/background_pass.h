@@ -1,6 +1,6 @@
 // render/src/background_pass.h (private): the environment behind the mesh, the probe rotated
-// by R (radiance toward w is probe(R^T w)), drawn as one full-screen triangle at depth 1 after
-// the mesh so only uncovered pixels pay for it (docs/ARCHITECTURE.md "Rendering").
+// by R (radiance toward w is probe(R^T w)), drawn as one opaque full-screen triangle before the
+// mesh in place of the colour clear (docs/ARCHITECTURE.md "Rendering").
 #pragma once
 
 #include "gl_program.h"
@@ -23,7 +23,9 @@ class BackgroundPass {
   // Replaces the texture (a viewer switching probes); same rules as the constructor.
   void set_probe(const probes::Probe* probe);
   bool has_probe() const { return have_probe_; }
-  // Where the depth buffer still holds the cleared 1.0; colour only, alpha kept (coverage).
+  // Every pixel's colour, alpha 0 (not coverage), with the depth test off and depth writes
+  // off: draw it first, instead of clearing colour, and let the mesh cover it. Leaves the
+  // depth test disabled and culling off; the caller sets its own state after.
   void draw(const Camera& camera, const Eigen::Matrix3d& rotation);
 
  private:

@@ -361,14 +361,13 @@ class MultipassPath : public ClusterPath {
   std::size_t passes() const override { return pass_ranges_.size(); }
   bool pass_drew(std::size_t p) const override { return pass_ranges_[p].count > 0; }
 
-  bool draw_depth(const Camera& camera) override {
+  void draw_depth(const Camera& camera) override {
     set_camera_uniforms(depth_program_, camera);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);  // rgb = 0, alpha = coverage
     glDepthFunc(GL_LESS);
     begin_work("depth", whole_.referenced);
     mesh_->draw(whole_);
     end_work();
-    return true;
   }
 
   void draw(const Camera& camera, const std::vector<GLuint>& queries) override {

@@ -86,7 +86,17 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
     glDepthMask(GL_TRUE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glClearColor(0.f, 0.f, 0.f, 0.f);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    // As the renderer draws it: the background first, in place of the colour clear.
+    if (background) {
+      glClear(GL_DEPTH_BUFFER_BIT);
+      if (count) counter.begin("background", 3);
+      background->draw(camera, Eigen::Matrix3d::Identity());
+      if (count) counter.end();
+      glEnable(GL_DEPTH_TEST);
+      glDepthMask(GL_TRUE);
+    } else {
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    }
     program.use();
     glBindVertexArray(vao);
     glDepthFunc(GL_LESS);
@@ -94,11 +104,6 @@ double floor_frame_ms(const meshes::Mesh& mesh, const Camera& camera, const Floo
     if (count) counter.begin("mesh", referenced);
     glDrawElements(GL_TRIANGLES, GLsizei(indices.size()), GL_UNSIGNED_INT, nullptr);
     if (count) counter.end();
-    if (background) {
-      if (count) counter.begin("background", 3);
-      background->draw(camera, Eigen::Matrix3d::Identity());
-      if (count) counter.end();
-    }
     glFinish();
     if (count) *options.work = counter.read();
     if (options.last_frame && f + 1 == options.frames) *options.last_frame = target.read();

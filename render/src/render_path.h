@@ -31,10 +31,9 @@ class RenderPath {
   // `queries` (one per pass()), counts each pass's primitives. By default: one draw of the
   // program given to shade_whole().
   virtual void draw(const Camera& camera, const std::vector<GLuint>& queries);
-  // A depth pre-pass that draw() relies on, if the path has one: drawn first, so that the
-  // renderer can draw the background (where depth stays 1) and flush both to llvmpipe's
-  // rasterizer threads while draw() shades vertices on this one. False: none drawn.
-  virtual bool draw_depth(const Camera&) { return false; }
+  // A depth pre-pass that draw() relies on, if the path has one (none by default): drawn
+  // right before draw(), into the same state.
+  virtual void draw_depth(const Camera&) {}
   // The per-vertex radiance the vertex stage produces, in GPU vertex order. By default: the
   // program given to shade_whole(), run over every vertex once.
   virtual std::vector<Rgb> capture(const Camera& camera);

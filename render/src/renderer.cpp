@@ -111,14 +111,29 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
   target.bind(camera.width, camera.height, stats.accumulation == Accumulation::kFloat16);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
-  // A solid background is the clear colour (alpha 0: not coverage); the multipass pre-pass
-  // writes (0, 0, 0, 1) over it wherever the mesh is, so the additive passes start at zero.
-  const bool probe_background = background.use_probe && background_pass.has_probe();
-  const Rgb clear = probe_background ? Rgb::Zero() : background.colour;
-  glClearColor(clear.x(), clear.y(), clear.z(), 0.f);
   glClearDepth(1.0);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  work.reset();
+  // A probe background writes every pixel (alpha 0: not coverage) and so replaces the colour
+  // clear, which costs llvmpipe at RGBA32F about what the whole pass costs without its tap.
+  // Every path then writes each pixel its depth test passes (the multipass pre-pass writes
+  // (0, 0, 0, 1), so the additive passes start at zero). Not flushed: in one scene with the
+  // mesh, llvmpipe shades each tile's background and mesh together while the tile is in
+  // cache, which measured faster than flushing the background to the rasterizer threads
+  // ahead of the mesh's vertex work (docs/BENCHMARKS.md "### Background"). A solid
+  // background is the clear colour (alpha 0).
+  const bool probe_background = background.use_probe && background_pass.has_probe();
+  if (probe_background) {
+    glClear(GL_DEPTH_BUFFER_BIT);
+    if (options.count_work) work.begin("background", 3);
+    background_pass.draw(camera, rotation_matrix);
+    if (options.count_work) work.end();
+    glDepthMask(GL_TRUE);  // the pass turns depth writes off
+  } else {
+    glClearColor(background.colour.x(), background.colour.y(), background.colour.z(), 0.f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  }
   glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);  // the multipass path leaves GL_EQUAL in a context renderers share
   glDisable(GL_BLEND);
   if (options.cull_back_faces) {
     glEnable(GL_CULL_FACE);
@@ -133,25 +148,9 @@ void Renderer::Impl::draw(const Camera& camera, const Eigen::Matrix3d& rotation_
     queries.assign(path->passes(), 0);
     glGenQueries(GLsizei(queries.size()), queries.data());
   }
-  work.reset();
   path->set_work_counter(options.count_work ? &work : nullptr);
-  // Background where no triangle wrote depth (depth is still the cleared 1.0): right after a
-  // depth pre-pass, flushed so that it rasterizes while the path shades, else after the path.
-  auto draw_background = [&] {
-    if (!probe_background) return;
-    if (options.count_work) work.begin("background", 3);
-    background_pass.draw(camera, rotation_matrix);
-    if (options.count_work) work.end();
-    if (options.cull_back_faces) glEnable(GL_CULL_FACE);  // the background pass turns it off
-    path->mesh().bind();
-  };
-  const bool depth_first = path->draw_depth(camera);
-  if (depth_first) {
-    draw_background();
-    glFlush();
-  }
+  path->draw_depth(camera);
   path->draw(camera, options.count_primitives ? queries : std::vector<GLuint>{});
-  if (!depth_first) draw_background();
   glDepthMask(GL_TRUE);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   path->mesh().bind();

@@ -19,8 +19,9 @@ struct FloorOptions {
   bool cull_back_faces = true;
   bool optimize_vertex_cache = true;
   int frames = 20, warmup = 3;
-  // The renderer's probe background pass after the mesh, so the floor has the same passes
-  // over the framebuffer as a real frame (like-for-like ratios); null = mesh only.
+  // The renderer's probe background pass, drawn first in place of the colour clear as the
+  // renderer draws it, so the floor has the same passes over the framebuffer as a real frame
+  // (like-for-like ratios); null = mesh only.
   const probes::Probe* background = nullptr;
   // When set, the pipeline statistics of the last frame's draws (RenderStats::pass_work).
   std::vector<PassWork>* work = nullptr;
