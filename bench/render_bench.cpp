@@ -44,7 +44,7 @@ double process_cpu_ms() {
 }
 
 struct Sample {
-  double overdraw = 0, frame_ms = 0, cpu_ms = 0;  // cpu: process CPU over all threads
+  double overdraw = 0, frame_ms = 0, cpu_ms = 0;          // cpu: process CPU over all threads
   render::Constants constants = render::Constants::kCpu;  // where the row's were computed
 };
 

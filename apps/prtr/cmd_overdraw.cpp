@@ -262,7 +262,8 @@ constexpr const char* kAbout =
 }  // namespace cmd_overdraw
 
 Runner add_overdraw_command(CLI::App& app) {
-  return add_command<cmd_overdraw::Options>(app, "overdraw", cmd_overdraw::kAbout, cmd_overdraw::add_flags, cmd_overdraw::run);
+  return add_command<cmd_overdraw::Options>(app, "overdraw", cmd_overdraw::kAbout,
+                                            cmd_overdraw::add_flags, cmd_overdraw::run);
 }
 
 }  // namespace prtr_app

@@ -341,7 +341,8 @@ constexpr const char* kAbout =
 }  // namespace cmd_relight
 
 Runner add_relight_command(CLI::App& app) {
-  return add_command<cmd_relight::Options>(app, "relight", cmd_relight::kAbout, cmd_relight::add_flags, cmd_relight::run);
+  return add_command<cmd_relight::Options>(app, "relight", cmd_relight::kAbout,
+                                           cmd_relight::add_flags, cmd_relight::run);
 }
 
 }  // namespace prtr_app

@@ -275,7 +275,8 @@ constexpr const char* kAbout =
 }  // namespace cmd_render
 
 Runner add_render_command(CLI::App& app) {
-  return add_command<cmd_render::Options>(app, "render", cmd_render::kAbout, cmd_render::add_flags, cmd_render::run);
+  return add_command<cmd_render::Options>(app, "render", cmd_render::kAbout, cmd_render::add_flags,
+                                          cmd_render::run);
 }
 
 }  // namespace prtr_app

@@ -213,7 +213,8 @@ constexpr const char* kAbout =
 }  // namespace cmd_view
 
 Runner add_view_command(CLI::App& app) {
-  return add_command<cmd_view::Options>(app, "view", cmd_view::kAbout, cmd_view::add_flags, cmd_view::run);
+  return add_command<cmd_view::Options>(app, "view", cmd_view::kAbout, cmd_view::add_flags,
+                                        cmd_view::run);
 }
 
 }  // namespace prtr_app

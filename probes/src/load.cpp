@@ -35,7 +35,6 @@ namespace probes {
 
 namespace {
 
-
 [[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
   throw ProbeError(path.string() + ": " + what);
 }
@@ -124,7 +123,7 @@ std::vector<Rgb> angular_to_latlong(const std::vector<Rgb>& angular, int n) {
         // Angle from -Z, and the direction of (x, y) in the image plane.
         const double planar = std::hypot(d.x(), d.y());
         const double angle = std::atan2(planar, -d.z());  // [0, pi]
-        const double r = angle / std::numbers::pi;                     // [0, 1] of the half-width
+        const double r = angle / std::numbers::pi;        // [0, 1] of the half-width
         // On the Z axis the image direction is undefined; r is 0 (centre) or 1 (the rim,
         // which is all +Z), so any direction does.
         const double sx = planar > 0.0 ? r * d.x() / planar : r;

@@ -23,8 +23,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdint>
 #include <chrono>
+#include <cstdint>
 #include <fstream>
 #include <memory>
 #include <numbers>

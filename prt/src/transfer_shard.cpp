@@ -22,20 +22,20 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::size_t kOffIndex = 16;            // u32
-constexpr std::size_t kOffCount = 20;            // u32
-constexpr std::size_t kOffFirst = 24;            // u64
-constexpr std::size_t kOffEnd = 32;              // u64
+constexpr std::size_t kOffIndex = 16;              // u32
+constexpr std::size_t kOffCount = 20;              // u32
+constexpr std::size_t kOffFirst = 24;              // u64
+constexpr std::size_t kOffEnd = 32;                // u64
 constexpr std::size_t kShardPayloadFloats = 40;    // u64
 constexpr std::size_t kShardPayloadChecksum = 48;  // u64
 constexpr std::size_t kPrefixBytes = common::kVersionedHeaderBytes + kTransferHeaderBytes;
 
 constexpr common::VersionedFormat kShardFormat{"transfer shard",
-                                          "shard written by prtr bake --shard",
-                                          "create it with prtr bake --shard k/n",
-                                          "bake that shard again with prtr bake --shard",
-                                          {'P', 'R', 'T', 'R', 'S', 'H', 'R', 'D'},
-                                          1};
+                                               "shard written by prtr bake --shard",
+                                               "create it with prtr bake --shard k/n",
+                                               "bake that shard again with prtr bake --shard",
+                                               {'P', 'R', 'T', 'R', 'S', 'H', 'R', 'D'},
+                                               1};
 
 struct Shard {
   fs::path path;
@@ -53,7 +53,8 @@ Shard open_shard(const fs::path& path) {
   const std::string name = path.string();
   common::OpenedVersionedFile opened = common::open_versioned(path, kShardFormat);
   if (!opened.problem.empty()) throw error(name + ": " + opened.problem);
-  if (const std::string p = common::header_checksum_problem(opened.header, kShardFormat); !p.empty())
+  if (const std::string p = common::header_checksum_problem(opened.header, kShardFormat);
+      !p.empty())
     throw error(name + ": " + p);
   Shard s;
   s.path = path;

@@ -44,11 +44,10 @@ GLuint compile(GLenum stage, const std::string& source, const std::string& name)
     const std::string log = shader_log(shader);
     glDeleteShader(shader);
     throw GlError("GLSL compile error in " + name +
-                  (stage == GL_VERTEX_SHADER     ? " (vertex)"
+                  (stage == GL_VERTEX_SHADER    ? " (vertex)"
                    : stage == GL_COMPUTE_SHADER ? " (compute)"
                                                 : " (fragment)") +
-                  ":\n" + log +
-                  "source:\n" + excerpt(source, log));
+                  ":\n" + log + "source:\n" + excerpt(source, log));
   }
   return shader;
 }

@@ -12,8 +12,7 @@ namespace render {
 namespace {
 
 // Storage bindings of the dispatch only; the paths bind theirs (0 and 1) at draw time.
-constexpr GLuint kRowsBinding = 4, kSourcesBinding = 5, kLightingBinding = 6,
-                 kOutputBinding = 7;
+constexpr GLuint kRowsBinding = 4, kSourcesBinding = 5, kLightingBinding = 6, kOutputBinding = 7;
 constexpr std::uint32_t kNoSource = 0xffffffffu;
 constexpr GLuint kGroupSize = 64;
 
@@ -86,8 +85,8 @@ GpuConstants::GpuConstants(const ShadingConstants& constants,
   sources_ = make_buffer(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(sources.size() * 4), sources.data(),
                          GL_STATIC_DRAW);
   host_lighting_.resize(std::size_t(3 * n_));
-  lighting_ = make_buffer(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(host_lighting_.size() * 4),
-                          nullptr, GL_DYNAMIC_DRAW);
+  lighting_ = make_buffer(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(host_lighting_.size() * 4), nullptr,
+                          GL_DYNAMIC_DRAW);
   count_ = std::uint32_t(total_floats);
   check_gl("GpuConstants: set-up");
 }

@@ -76,8 +76,7 @@ RenderStats initial_stats(const meshes::Mesh& mesh) {
 // gain nothing from them.
 Accumulation resolve_accumulation(Accumulation wanted) {
   if (wanted != Accumulation::kAuto) return wanted;
-  return current_gl_info().software_rasterizer() ? Accumulation::kFloat32
-                                                 : Accumulation::kFloat16;
+  return current_gl_info().software_rasterizer() ? Accumulation::kFloat32 : Accumulation::kFloat16;
 }
 
 Renderer::Impl::Impl(const meshes::Mesh& mesh, const cpca::CompressedSet* set,
