@@ -105,6 +105,22 @@ def check_compression(browser):
           text(browser, "stat-clusters") == "4" and text(browser, "stat-se") != "-")
 
 
+def check_order(browser):
+    """Another SH order chosen in the page: baked and compressed in the background, shown
+    when ready (the launch's order 3 until then), and back to the launch's at once (kept)."""
+    set_control(browser, "order", "2")
+    browser.wait_for("document.getElementById('stat-order').textContent === '2'",
+                     timeout=90, what="the order-2 bake and compression")
+    check("order: 2 shown with the launch's clusters and no progress left",
+          text(browser, "stat-clusters") == "4" and text(browser, "compress-status") == "",
+          "%s / %s" % (text(browser, "stat-clusters"), text(browser, "compress-status")))
+    set_control(browser, "order", "3")
+    browser.wait_for("document.getElementById('stat-order').textContent === '3'",
+                     what="back to order 3")
+    check("order: the launch's back, with its Average SE", text(browser, "stat-se") != "-",
+          text(browser, "stat-se"))
+
+
 def check_refusals(browser, cx, cy):
     """A refused setting does not poison the tab: the field goes back to the value in use,
     the reason shows beside it, and the next drag renders."""
@@ -241,6 +257,7 @@ def run(browser, server, tmp):
     check("difference view changes the frame", browser.evaluate(PIXELS)["hash"] != overlaid["hash"])
     browser.evaluate("document.getElementById('overlay-difference').click()")
     check_compression(browser)
+    check_order(browser)
     check_refusals(browser, cx, cy)
     check_keys_and_autorotate(browser)
     check_fit_window(browser)

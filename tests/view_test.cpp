@@ -42,6 +42,7 @@ ViewLimits limits() {
   l.max_clusters = 100;
   l.max_components = 12;
   l.floats_per_term = 48;  // order 4 glossy: 16 rows x 3 colours
+  l.max_order = 8;
   return l;
 }
 
@@ -61,7 +62,7 @@ TEST(ViewRequest, EveryParameterLandsInTheState) {
       {"env_yaw", "-30.5"},  {"env_pitch", "12"},   {"cam_yaw", "90"},     {"cam_pitch", "-45"},
       {"zoom", "1.5"},       {"mode", "multipass"}, {"strategy", "order"}, {"budget", "512"},
       {"cpp", "4"},          {"probe", "1"},        {"exposure", "-1.25"}, {"overlay", "overdraw"},
-      {"aa", "2"},           {"clusters", "40"},    {"pcs", "3"}};
+      {"aa", "2"},           {"clusters", "40"},    {"pcs", "3"},          {"order", "5"}};
   const ViewState s = viewer::parse_view_request(q, limits());
   EXPECT_EQ(s.client, "tab-1_x");
   EXPECT_EQ(s.seq, 42u);
@@ -82,6 +83,7 @@ TEST(ViewRequest, EveryParameterLandsInTheState) {
   EXPECT_EQ(s.samples, 2);
   EXPECT_EQ(s.clusters, 40);
   EXPECT_EQ(s.pcs, 3);
+  EXPECT_EQ(s.order, 5);
   EXPECT_EQ(q.size(), viewer::view_parameter_names().size());  // all of them were covered
 }
 
@@ -186,8 +188,19 @@ TEST(ViewRequest, OtherCompressionsAreBoundedAndPriceTheirPasses) {
   EXPECT_EQ(refusal({{"pcs", "3"}, {"budget", "100"}, {"cpp", "3"}}, l),
             "cpp=3: 2 clusters fit the budget of 100 registers; use 0 (all that fit) or 1 to 2");
   EXPECT_EQ(refusal({{"pcs", "3"}, {"budget", "100"}, {"cpp", "2"}}, l), "(accepted)");
+  // Another SH order prices a term at its own rows: order 4 has 3 x 16 = 48 floats a term,
+  // so the launch's 3 PCs cost 48 registers at order 4 where the budget of 100 fits 2.
+  l.launch_order = 6;
+  l.launch_components = 3;
+  l.floats_per_term = 108;
+  l.max_order = 8;
+  EXPECT_EQ(refusal({{"order", "4"}, {"budget", "100"}, {"cpp", "3"}}, l),
+            "cpp=3: 2 clusters fit the budget of 100 registers; use 0 (all that fit) or 1 to 2");
+  EXPECT_EQ(refusal({{"order", "4"}, {"budget", "100"}, {"cpp", "2"}}, l), "(accepted)");
+  EXPECT_EQ(refusal({{"order", "9"}}, l).rfind("order=", 0), 0u);
+  EXPECT_EQ(refusal({{"order", "0"}}, l), "(accepted)");
   // A viewer without other compressions takes only the launch's.
-  l.max_clusters = l.max_components = 0;
+  l.max_clusters = l.max_components = l.max_order = 0;
   EXPECT_EQ(refusal({{"clusters", "0"}}, l), "(accepted)");
   EXPECT_EQ(refusal({{"clusters", "8"}}, l),
             "clusters='8': this viewer offers only its launch compression");
@@ -199,25 +212,29 @@ TEST(ViewCompressions, TheOldOneIsShownUntilTheNewOneIsReady) {
   cpca::CompressedSet launch;
   launch.cluster_count = 16;
   launch.component_count = 4;
+  launch.order = 6;
   std::promise<void> release;
   std::shared_future<void> gate = release.get_future().share();
   std::atomic<int> made{0};
-  viewer::Compressions c(launch, [&](int clusters, int pcs, const auto& progress) {
-    progress(0.5);
-    gate.wait();
-    if (clusters == 7) throw std::runtime_error("7 clusters refused");
-    ++made;
-    cpca::CompressedSet s;
-    s.cluster_count = clusters;
-    s.component_count = pcs;
-    return s;
-  });
+  viewer::Compressions c(
+      {launch, "launch.prtx"}, [&](int clusters, int pcs, int order, const auto& progress) {
+        progress(0.5);
+        gate.wait();
+        if (clusters == 7) throw std::runtime_error("7 clusters refused");
+        ++made;
+        cpca::CompressedSet s;
+        s.cluster_count = clusters;
+        s.component_count = pcs;
+        s.order = order;
+        // Another order comes from another bake.
+        return viewer::Compression{s, order == 6 ? "launch.prtx" : "order" + std::to_string(order)};
+      });
   viewer::CompressionStatus st = c.choose(8, 0);
   EXPECT_TRUE(st.pending);
   EXPECT_EQ(st.shown->cluster_count, 16);
-  const auto wait_ready = [&](int clusters, int pcs) {
+  const auto wait_ready = [&](int clusters, int pcs, int order = 0) {
     for (int i = 0; i < 2000; ++i) {
-      st = c.choose(clusters, pcs);
+      st = c.choose(clusters, pcs, order);
       if (!st.pending) return;
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
@@ -239,9 +256,19 @@ TEST(ViewCompressions, TheOldOneIsShownUntilTheNewOneIsReady) {
   st = c.choose(0, 0);
   EXPECT_FALSE(st.pending);
   EXPECT_EQ(st.shown->cluster_count, 16);
+  EXPECT_EQ(st.transfer, "launch.prtx");
   st = c.choose(8, 4);  // made once, kept
   EXPECT_FALSE(st.pending);
   EXPECT_EQ(made.load(), 1);
+  // Another SH order is another compression, with its own bake; the launch's order is 0's.
+  wait_ready(8, 4, 3);
+  EXPECT_EQ(st.shown->order, 3);
+  EXPECT_EQ(st.transfer, "order3");
+  EXPECT_EQ(made.load(), 2);
+  st = c.choose(8, 4, 6);
+  EXPECT_FALSE(st.pending);
+  EXPECT_EQ(st.shown->order, 6);
+  EXPECT_EQ(made.load(), 2);
 }
 
 TEST(ViewRequest, RawQueriesAreSplitStrictly) {

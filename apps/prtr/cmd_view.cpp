@@ -12,6 +12,7 @@
 #include "pipeline/pipeline.h"
 #include "probes/load.h"
 #include "progress_bar.h"
+#include "prt/sh.h"
 #include "supersample_flag.h"
 #include "view_flags.h"
 #include "viewer/scene.h"
@@ -113,6 +114,7 @@ Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::Compresse
               {"pcs", set.component_count},
               {"max_clusters", served.limits.max_clusters},
               {"max_pcs", served.limits.max_components},
+              {"max_order", served.limits.max_order},
               {"order", set.order},
               {"average_se", summary.average_se},
               {"relative_error", summary.relative_error},
@@ -171,28 +173,43 @@ void run(const Options& o, CLI::App*) {
   const pipeline::CacheResult transfer = pipeline::cached_bake(mesh, o.mesh, bake, cache, reporter);
   const pipeline::CompressCacheResult compressed =
       pipeline::cached_compress(transfer.path, mesh, o.mesh, compress, cache, reporter);
-  // Other clusters and PCs from the page: the same cached compression, in the background.
-  const auto make = [&](int clusters, int pcs, const std::function<void(double)>& progress) {
+  // Other clusters, PCs and SH orders from the page: the same cached pipeline, in the
+  // background; another order bakes first (half the progress), then compresses.
+  const auto make = [&](int clusters, int pcs, int order,
+                        const std::function<void(double)>& progress) {
+    prt::BakeOptions b = bake;
+    b.order = order;
     cpca::CompressOptions c = compress;
     c.clusters = clusters;
     c.components = pcs;
+    const bool baking = order != bake.order;
     pipeline::Reporter quiet;
+    double base = 0.0, share = baking ? 0.5 : 1.0;
     quiet.progress = [&](const std::string&, std::uint64_t done, std::uint64_t total) {
-      if (total > 0) progress(double(done) / double(total));
+      if (total > 0) progress(base + share * double(done) / double(total));
     };
-    return cpca::read_compressed(
-        pipeline::cached_compress(transfer.path, mesh, o.mesh, c, cache, quiet).path);
+    const fs::path bake_path =
+        baking ? pipeline::cached_bake(mesh, o.mesh, b, cache, quiet).path : transfer.path;
+    if (baking) base = 0.5;
+    return viewer::Compression{
+        cpca::read_compressed(
+            pipeline::cached_compress(bake_path, mesh, o.mesh, c, cache, quiet).path),
+        bake_path};
   };
-  viewer::Compressions compressions(cpca::read_compressed(compressed.path), make);
+  viewer::Compressions compressions({cpca::read_compressed(compressed.path), transfer.path}, make);
   const cpca::CompressedSet& set = compressions.launch();
-  viewer::ViewScene scene(
-      {&mesh, &compressions, transfer.path, probes, placement, background, axis, gl});
+  viewer::ViewScene scene({&mesh, &compressions, probes, placement, background, axis, gl});
   served.limits = {int(probes.size()), set.cluster_count, true};
   // The page may ask for up to 64 PCs; the compression refuses more than the data holds.
   served.limits.max_clusters = int(std::min<std::size_t>(mesh.vertex_count(), 65536));
   served.limits.max_components = 64;
   served.limits.floats_per_term =
       render::constant_layout(set.order, set.glossy(), 0).floats_per_cluster();
+  // Orders past 8 make bakes of gigabytes for a mesh like the bunny (order 10: 1.4 GB).
+  served.limits.max_order = std::max(set.order, std::min(8, prt::kMaxOrder));
+  served.limits.launch_order = set.order;
+  served.limits.launch_components = set.component_count;
+  served.limits.glossy = set.glossy();
   served.limits.max_register_budget = scene.info().default_register_budget;
   served.limits.registers_per_cluster = scene.info().registers_per_cluster;
   // The initial state renders once here, so a flag the renderer refuses exits 2 now.

@@ -4,11 +4,16 @@
 
 namespace viewer {
 
-Compressions::Compressions(cpca::CompressedSet launch, MakeCompression make)
-    : launch_(std::make_shared<const cpca::CompressedSet>(std::move(launch))),
+Compressions::Compressions(Compression launch, MakeCompression make)
+    : launch_(std::make_shared<const Compression>(std::move(launch))),
       make_(std::move(make)),
       shown_(launch_) {
-  made_[{launch_->cluster_count, launch_->component_count}] = launch_;
+  made_[{launch_->set.cluster_count, launch_->set.component_count, launch_->set.order}] = launch_;
+}
+
+CompressionStatus Compressions::status(bool pending, double progress, std::string error) const {
+  return {std::shared_ptr<const cpca::CompressedSet>(shown_, &shown_->set), shown_->transfer,
+          pending, progress, std::move(error)};
 }
 
 Compressions::~Compressions() {
@@ -20,18 +25,18 @@ Compressions::~Compressions() {
   if (worker_.joinable()) worker_.join();
 }
 
-CompressionStatus Compressions::choose(int clusters, int pcs) {
-  const Key key{clusters > 0 ? clusters : launch_->cluster_count,
-                pcs > 0 ? pcs : launch_->component_count};
+CompressionStatus Compressions::choose(int clusters, int pcs, int order) {
+  const cpca::CompressedSet& l = launch_->set;
+  const Key key{clusters > 0 ? clusters : l.cluster_count, pcs > 0 ? pcs : l.component_count,
+                order > 0 ? order : l.order};
   std::lock_guard lock(mutex_);
   if (const auto it = made_.find(key); it != made_.end()) {
     shown_ = it->second;
-    return {shown_, false, 1.0, {}};
+    return status(false, 1.0, {});
   }
-  if (const auto it = failed_.find(key); it != failed_.end())
-    return {shown_, false, 0.0, it->second};
-  if (!make_) return {shown_, false, 0.0, "this viewer offers only its launch compression"};
-  if (making_ == key) return {shown_, true, progress_, {}};
+  if (const auto it = failed_.find(key); it != failed_.end()) return status(false, 0.0, it->second);
+  if (!make_) return status(false, 0.0, "this viewer offers only its launch compression");
+  if (making_ == key) return status(true, progress_, {});
   queued_ = key;
   if (!making_) {
     // The previous worker has set making_ empty as its last act under the lock.
@@ -41,7 +46,7 @@ CompressionStatus Compressions::choose(int clusters, int pcs) {
     progress_ = 0.0;
     worker_ = std::thread([this] { work(); });
   }
-  return {shown_, true, making_ == key ? progress_ : 0.0, {}};
+  return status(true, making_ == key ? progress_ : 0.0, {});
 }
 
 void Compressions::work() {
@@ -49,11 +54,11 @@ void Compressions::work() {
   while (making_ && !stopping_) {
     const Key key = *making_;
     lock.unlock();
-    std::shared_ptr<const cpca::CompressedSet> set;
+    Made set;
     std::string error;
     try {
-      set = std::make_shared<const cpca::CompressedSet>(
-          make_(key.first, key.second, [this](double done) {
+      set = std::make_shared<const Compression>(
+          make_(key.clusters, key.pcs, key.order, [this](double done) {
             std::lock_guard progress_lock(mutex_);
             progress_ = done;
           }));

@@ -41,8 +41,8 @@ auto-rotates, r resets</div>
 <div class="refused" id="refused-budget"></div>
 <label>clusters per pass <input id="cpp" type="number" min="0" step="1" value="0"> (0: all that fit)</label>
 <div class="refused" id="refused-cpp"></div>
-<label>clusters <input id="clusters" type="number" min="1" step="1"> PCs <input id="pcs" type="number" min="1" step="1"></label>
-<div class="refused" id="refused-clusters"></div><div class="refused" id="refused-pcs"></div>
+<label>clusters <input id="clusters" type="number" min="1" step="1"> PCs <input id="pcs" type="number" min="1" step="1"> SH order <input id="order" type="number" min="1" step="1"></label>
+<div class="refused" id="refused-clusters"></div><div class="refused" id="refused-pcs"></div><div class="refused" id="refused-order"></div>
 <div id="compress-status"></div>
 <label>size <select id="size"></select></label>
 <label><input type="checkbox" id="antialias" checked> anti-alias the still image (<span id="antialias-samples">2 × 2</span> samples once the view stops)</label>
@@ -88,13 +88,14 @@ const client = "c" + Math.random().toString(36).slice(2, 12);
 const urlParams = new URLSearchParams(location.search);
 const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch: 0, zoom: 1,
   mode: "decoupled", strategy: "greedy-refine", budget: 0, cpp: 0, probe: 0, exposure: 0,
-  overlay: "none", aa: 1, clusters: 0, pcs: 0 };
+  overlay: "none", aa: 1, clusters: 0, pcs: 0, order: 0 };
 let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
 let good = null;         // the last state that rendered: a refused setting falls back to it
 let stillSamples = 2;    // prtr view --supersample: samples per pixel of a still view
 // Which control sets a query parameter, so that a refusal is shown beside it.
 const controlOf = { budget: "budget", cpp: "cpp", w: "size", h: "size", mode: "mode",
-  strategy: "strategy", probe: "probe", exposure: "exposure", clusters: "clusters", pcs: "pcs" };
+  strategy: "strategy", probe: "probe", exposure: "exposure", clusters: "clusters", pcs: "pcs",
+  order: "order" };
 let launch = null;       // the launch compression's clusters, PCs and Average SE (/api/info)
 const log = [];          // per frame: {sent, shown, queue, render, overlay, encode, transfer}
 window.prtrLog = log;    // read by the measurement script
@@ -186,12 +187,17 @@ let compressPoll = null;
 function showCompression(f) {
   $("stat-clusters").textContent = String(f.clusters);
   $("stat-pcs").textContent = String(f.pcs);
-  const atLaunch = launch && f.clusters === launch.clusters && f.pcs === launch.pcs;
+  $("stat-order").textContent = String(f.order);
+  const atLaunch = launch && f.clusters === launch.clusters && f.pcs === launch.pcs &&
+      f.order === launch.order;
   $("stat-se").textContent = atLaunch ? launch.average_se.toPrecision(4) : "-";
-  const asked = (state.clusters || f.clusters) + " × " + (state.pcs || f.pcs);
+  const asked = (state.clusters || f.clusters) + " × " + (state.pcs || f.pcs) + ", order " +
+      (state.order || f.order);
+  // Another order bakes before it compresses.
   $("compress-status").textContent = f.compressing
-      ? "compressing " + asked + ": " + Math.round(100 * f.compress_progress) + " % (showing " +
-        f.clusters + " × " + f.pcs + ")" : "";
+      ? (state.order && state.order !== f.order ? "baking and compressing " : "compressing ") +
+        asked + ": " + Math.round(100 * f.compress_progress) + " % (showing " + f.clusters +
+        " × " + f.pcs + ", order " + f.order + ")" : "";
   // Cleared when the field changes, so a refusal the server gave stays readable meanwhile.
   if (f.compress_error) $("refused-clusters").textContent = asked + ": " + f.compress_error;
   if (f.compressing && !compressPoll)
@@ -298,9 +304,10 @@ function bindSelect(id, key, parse) {
 bindSelect("mode", "mode", String);
 bindSelect("strategy", "strategy", String);
 bindSelect("probe", "probe", Number);
-for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"], ["clusters", "clusters"], ["pcs", "pcs"]])
+for (const [id, key] of [["budget", "budget"], ["cpp", "cpp"], ["clusters", "clusters"], ["pcs", "pcs"],
+                         ["order", "order"]])
   $(id).addEventListener("change", () => {
-    const least = key === "clusters" || key === "pcs" ? 1 : 0;
+    const least = key === "clusters" || key === "pcs" || key === "order" ? 1 : 0;
     state[key] = Math.max(least, Math.floor(Number($(id).value) || 0));
     $(id).value = String(state[key]);
     $("refused-" + id).textContent = "";
@@ -375,10 +382,13 @@ async function start() {
   $("exposure-value").textContent = state.exposure.toFixed(2);
   $("stat-clusters").textContent = String(info.clusters);
   $("stat-pcs").textContent = String(info.pcs);
-  launch = { clusters: info.clusters, pcs: info.pcs, average_se: info.average_se };
-  state.clusters = info.clusters; state.pcs = info.pcs;
+  launch = { clusters: info.clusters, pcs: info.pcs, order: info.order,
+    average_se: info.average_se };
+  state.clusters = info.clusters; state.pcs = info.pcs; state.order = info.order;
   $("clusters").value = String(info.clusters); $("pcs").value = String(info.pcs);
+  $("order").value = String(info.order);
   $("clusters").max = String(info.max_clusters); $("pcs").max = String(info.max_pcs);
+  $("order").max = String(info.max_order);
   $("stat-order").textContent = String(info.order);
   $("stat-se").textContent = info.average_se.toPrecision(4);
   $("stat-mesh").textContent = info.mesh + " (" + info.vertices + " vertices)";

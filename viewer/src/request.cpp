@@ -138,6 +138,7 @@ const std::vector<std::pair<std::string, Setter>>& setters() {
       {"clusters",
        [](S& s, V v, L l) { s.clusters = compression_size("clusters", v, l.max_clusters); }},
       {"pcs", [](S& s, V v, L l) { s.pcs = compression_size("pcs", v, l.max_components); }},
+      {"order", [](S& s, V v, L l) { s.order = compression_size("order", v, l.max_order); }},
       {"probe",
        [](S& s, V v, L l) { s.probe = int(parse_integer("probe", v, 0, l.probe_count - 1)); }},
       {"exposure", [](S& s, V v, L) { s.exposure = parse_double("exposure", v, -20, 20); }},
@@ -213,8 +214,16 @@ namespace {
 // decides (the renderer's own refusal names command-line flags), this says which values
 // would fit.
 void check_passes(const ViewState& state, const ViewLimits& limits) {
-  const int cost = state.pcs > 0 && limits.floats_per_term > 0
-                       ? ((state.pcs + 1) * limits.floats_per_term + 3) / 4
+  // Another order prices a term at its own rows (glossy: n^2 per colour).
+  const bool other_order = state.order > 0 && limits.launch_order > 0 && limits.glossy &&
+                           state.order != limits.launch_order;
+  const int floats_per_term = other_order ? limits.floats_per_term /
+                                                (limits.launch_order * limits.launch_order) *
+                                                state.order * state.order
+                                          : limits.floats_per_term;
+  const int pcs = state.pcs > 0 ? state.pcs : limits.launch_components;
+  const int cost = (state.pcs > 0 || other_order) && floats_per_term > 0
+                       ? ((pcs + 1) * floats_per_term + 3) / 4
                        : limits.registers_per_cluster;
   const render::PassCapacity c =
       render::check_pass_capacity(std::max(1, cost), state.register_budget,

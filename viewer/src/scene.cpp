@@ -42,7 +42,8 @@ std::string renderer_key(const ViewState& s, const cpca::CompressedSet& set) {
   const bool grouped = s.mode == render::Mode::kMultipass || s.mode == render::Mode::kDecoupled;
   return std::string(render::kModeNames.name(s.mode)) + "/" + (grouped ? s.strategy : "-") + "/" +
          std::to_string(s.register_budget) + "/" + std::to_string(s.clusters_per_pass) + "/" +
-         std::to_string(set.cluster_count) + "x" + std::to_string(set.component_count);
+         std::to_string(set.cluster_count) + "x" + std::to_string(set.component_count) + "/o" +
+         std::to_string(set.order);
 }
 
 }  // namespace
@@ -53,32 +54,35 @@ struct CachedRenderer {
   std::string key;
   std::shared_ptr<const cpca::CompressedSet> set;  // kept alive while its renderer is
   std::unique_ptr<render::Renderer> renderer;
-  std::vector<std::uint8_t> pass_counts;  // per triangle, for the overdraw overlay
-  int probe = -1;                         // the probe its background texture holds
+  std::vector<std::uint8_t> pass_counts;             // per triangle, for the overdraw overlay
+  int probe = -1;                                    // the probe its background texture holds
+  std::shared_ptr<const prt::TransferSet> transfer;  // the uncompressed mode's, kept alive
 };
 
 struct ViewScene::Impl {
   explicit Impl(SceneInputs in) : inputs(std::move(in)) {}
 
-  CachedRenderer& renderer_for(const ViewState& state,
-                               const std::shared_ptr<const cpca::CompressedSet>& set);
-  const prt::ShLighting& lighting_for(int probe);
+  CachedRenderer& renderer_for(const ViewState& state, const CompressionStatus& compression);
+  const prt::ShLighting& lighting_for(int probe, int order);
+  std::shared_ptr<const prt::TransferSet> transfer_for(const std::filesystem::path& path);
   const probes::Probe& probe_texels(int probe);
   std::vector<std::uint8_t> pass_counts(const render::Renderer& r, const cpca::CompressedSet& set,
                                         const std::optional<cpca::SuperClusters>& groups) const;
   void add_overlay(RenderedFrame& frame, const CachedRenderer& cached,
                    const render::Camera& camera) const;
   void add_difference(RenderedFrame& frame, const render::Camera& drawn, const prt::ShLighting& sh,
-                      const std::shared_ptr<const cpca::CompressedSet>& set);
+                      const CompressionStatus& compression);
   void render_into(RenderedFrame& frame);
 
   SceneInputs inputs;
   render::GlContext context{inputs.gl};
   SceneInfo info;
-  std::list<CachedRenderer> renderers;  // most recently used first
-  std::map<int, prt::ShLighting> lighting;
-  std::list<std::pair<int, probes::Probe>> probes_loaded;  // most recently used first
-  std::optional<prt::TransferSet> transfer;
+  std::list<CachedRenderer> renderers;                      // most recently used first
+  std::map<std::pair<int, int>, prt::ShLighting> lighting;  // by probe and SH order
+  std::list<std::pair<int, probes::Probe>> probes_loaded;   // most recently used first
+  // The last bake loaded (a renderer keeps its own alive): one at a time, as they are large.
+  std::filesystem::path transfer_path;
+  std::weak_ptr<const prt::TransferSet> transfer;
   Eigen::Vector3d axis = Eigen::Vector3d::UnitY();
 };
 
@@ -93,13 +97,20 @@ const probes::Probe& ViewScene::Impl::probe_texels(int probe) {
   return probes_loaded.front().second;
 }
 
-const prt::ShLighting& ViewScene::Impl::lighting_for(int probe) {
-  auto it = lighting.find(probe);
+const prt::ShLighting& ViewScene::Impl::lighting_for(int probe, int order) {
+  auto it = lighting.find({probe, order});
   if (it == lighting.end())
-    it = lighting
-             .emplace(probe, prt::project(probe_texels(probe), inputs.compressions->launch().order))
-             .first;
+    it = lighting.emplace(std::pair{probe, order}, prt::project(probe_texels(probe), order)).first;
   return it->second;
+}
+
+std::shared_ptr<const prt::TransferSet> ViewScene::Impl::transfer_for(
+    const std::filesystem::path& path) {
+  if (auto loaded = transfer.lock(); loaded && path == transfer_path) return loaded;
+  auto loaded = std::make_shared<const prt::TransferSet>(prt::read_transfer(path));
+  transfer = loaded;
+  transfer_path = path;
+  return loaded;
 }
 
 std::vector<std::uint8_t> ViewScene::Impl::pass_counts(
@@ -117,8 +128,9 @@ std::vector<std::uint8_t> ViewScene::Impl::pass_counts(
                                     cpca::group_clusters("order", input));
 }
 
-CachedRenderer& ViewScene::Impl::renderer_for(
-    const ViewState& state, const std::shared_ptr<const cpca::CompressedSet>& set) {
+CachedRenderer& ViewScene::Impl::renderer_for(const ViewState& state,
+                                              const CompressionStatus& compression) {
+  const std::shared_ptr<const cpca::CompressedSet>& set = compression.shown;
   const std::string key = renderer_key(state, *set);
   for (auto it = renderers.begin(); it != renderers.end(); ++it)
     if (it->key == key) {
@@ -135,15 +147,13 @@ CachedRenderer& ViewScene::Impl::renderer_for(
   if (ro.mode == render::Mode::kMultipass || ro.mode == render::Mode::kDecoupled)
     ro.groups = groups = render::group_for_renderer(*inputs.mesh, *set, context, ro.register_budget,
                                                     ro.clusters_per_pass, state.strategy);
-  if (ro.mode == render::Mode::kUncompressed && !transfer)
-    transfer = prt::read_transfer(inputs.transfer);
-  const probes::Probe& probe = probe_texels(state.probe);
   CachedRenderer cached;
+  if (ro.mode == render::Mode::kUncompressed) cached.transfer = transfer_for(compression.transfer);
+  const probes::Probe& probe = probe_texels(state.probe);
   cached.key = key;
   cached.set = set;
-  cached.renderer = std::make_unique<render::Renderer>(
-      *inputs.mesh, set.get(), ro.mode == render::Mode::kUncompressed ? &*transfer : nullptr,
-      &probe, ro);
+  cached.renderer = std::make_unique<render::Renderer>(*inputs.mesh, set.get(),
+                                                       cached.transfer.get(), &probe, ro);
   cached.renderer->set_background(inputs.background);
   cached.pass_counts = pass_counts(*cached.renderer, *set, groups);
   cached.probe = state.probe;
@@ -168,14 +178,15 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   const ViewState& s = frame.state;
   const auto start = Clock::now();
   const auto setup_start = Clock::now();
-  const CompressionStatus compression = inputs.compressions->choose(s.clusters, s.pcs);
+  const CompressionStatus compression = inputs.compressions->choose(s.clusters, s.pcs, s.order);
   frame.stats.clusters = compression.shown->cluster_count;
   frame.stats.pcs = compression.shown->component_count;
+  frame.stats.order = compression.shown->order;
   frame.stats.compressing = compression.pending;
   frame.stats.compress_progress = compression.progress;
   frame.stats.compress_error = compression.error;
-  CachedRenderer& cached = renderer_for(s, compression.shown);
-  const prt::ShLighting& sh = lighting_for(s.probe);
+  CachedRenderer& cached = renderer_for(s, compression);
+  const prt::ShLighting& sh = lighting_for(s.probe, compression.shown->order);
   if (cached.probe != s.probe) {
     cached.renderer->set_probe(&probe_texels(s.probe));
     cached.probe = s.probe;
@@ -200,7 +211,7 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
   frame.stats.clusters_per_pass = rs.clusters_per_pass;
   frame.stats.register_budget = rs.register_budget;
   if (s.overlay == Overlay::kDifference)
-    add_difference(frame, drawn, sh, compression.shown);
+    add_difference(frame, drawn, sh, compression);
   else
     add_overlay(frame, cached, camera);
 }
@@ -209,12 +220,12 @@ void ViewScene::Impl::render_into(RenderedFrame& frame) {
 // difference picture of the two.
 void ViewScene::Impl::add_difference(RenderedFrame& frame, const render::Camera& drawn,
                                      const prt::ShLighting& sh,
-                                     const std::shared_ptr<const cpca::CompressedSet>& set) {
+                                     const CompressionStatus& compression) {
   const auto start = Clock::now();
   const ViewState& s = frame.state;
   ViewState reference_state = s;
   reference_state.mode = render::Mode::kUncompressed;
-  CachedRenderer& reference = renderer_for(reference_state, set);
+  CachedRenderer& reference = renderer_for(reference_state, compression);
   if (reference.probe != s.probe) {
     reference.renderer->set_probe(&probe_texels(s.probe));
     reference.probe = s.probe;

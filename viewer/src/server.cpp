@@ -229,6 +229,7 @@ Json frame_header(const RenderedFrame& f) {
               {"requests", t.requests},
               {"clusters", t.clusters},
               {"pcs", t.pcs},
+              {"order", t.order},
               {"compressing", t.compressing},
               {"compress_progress", t.compress_progress},
               {"compress_error", t.compress_error}};

@@ -30,7 +30,7 @@ struct FrameStats {
   // The difference overlay's relative luminance difference from the uncompressed frame.
   double difference_rms = 0, difference_max = 0;
   // The compression shown, and the asked-for one when it differs (viewer/compressions.h).
-  int clusters = 0, pcs = 0;
+  int clusters = 0, pcs = 0, order = 0;
   bool compressing = false;
   double compress_progress = 0;
   std::string compress_error;

@@ -40,8 +40,8 @@ struct ViewState {
   double exposure = 0;        // stops
   Overlay overlay = Overlay::kNone;
   int samples = 1;  // anti-aliasing: samples x samples per pixel, box-filtered (1: off)
-  // The compression to show (viewer/compressions.h); 0: the launch's clusters or PCs.
-  int clusters = 0, pcs = 0;
+  // The compression to show (viewer/compressions.h); 0: the launch's clusters, PCs or SH order.
+  int clusters = 0, pcs = 0, order = 0;
 };
 
 // What the server accepts; the parser checks against it.
@@ -54,8 +54,12 @@ struct ViewLimits {
   int max_register_budget = 1 << 20;  // what the GL context offers
   int registers_per_cluster = 1;      // one cluster's constants; a budget below fits none
   // Other compressions the page may ask for (0: none): clusters up to max_clusters, PCs up to
-  // max_components; one cluster then takes ceil((PCs + 1) * floats_per_term / 4) registers.
-  int max_clusters = 0, max_components = 0, floats_per_term = 0;
+  // max_components, SH orders up to max_order (another order bakes first); one cluster then
+  // takes ceil((PCs + 1) * floats_per_term / 4) registers, floats_per_term being 3 n^2 at
+  // order n for glossy transfer (3 for diffuse).
+  int max_clusters = 0, max_components = 0, floats_per_term = 0, max_order = 0;
+  int launch_order = 0, launch_components = 0;  // floats_per_term is given at launch_order
+  bool glossy = true;
 };
 
 class RequestError : public std::invalid_argument {

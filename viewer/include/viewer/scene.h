@@ -22,8 +22,9 @@ namespace viewer {
 
 struct SceneInputs {
   const meshes::Mesh* mesh = nullptr;
-  Compressions* compressions = nullptr;  // the launch's compression and any the page asks for
-  std::filesystem::path transfer;        // the cached bake, loaded on the first uncompressed frame
+  // The launch's compression and any the page asks for, each with its bake (loaded on the
+  // first uncompressed or difference frame at its order).
+  Compressions* compressions = nullptr;
   std::vector<std::filesystem::path> probes;
   render::CameraPlacement camera;  // framing before the page orbits it (size comes per request)
   render::Background background;
