@@ -220,6 +220,22 @@ TEST_P(CaptureTest, EveryModeMatchesTheCpuReference) {
       }
 }
 
+// The warm-up frames last at least warmup_ms (a GPU left idle by a long set-up needs them to
+// reach its clocks), and the timed frames follow them.
+TEST(Renderer, WarmUpLastsAtLeastItsMilliseconds) {
+  render::GlContext ctx;
+  const Scene s = make_scene(meshes::make_sphere(1.f, 10, 5), 3, 10, 2);
+  render::Renderer r(s.mesh, &s.set, nullptr, &s.probe, options(render::Mode::kSinglepass));
+  const auto start = std::chrono::steady_clock::now();
+  const render::TimingSummary t = render::measure(r, s.camera, s.lighting, test_rotation(),
+                                                  Eigen::Vector3d::UnitY(), 1.0, 2, 1, 250.0);
+  const double elapsed =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_GE(elapsed, 250.0);
+  EXPECT_EQ(t.frames, 2);
+  EXPECT_GT(t.frame_ms_median, 0.0);
+}
+
 // The compute dispatch reruns every frame: after one rotation and then another, the image is
 // the CPU constants' image of the second, and differs from the first's.
 TEST(Renderer, GpuConstantsFollowTheLightingFrameByFrame) {

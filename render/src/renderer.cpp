@@ -248,6 +248,7 @@ TimingSummary measure(Renderer& renderer, const Camera& camera,
                       const Eigen::Matrix3d& start_rotation, const Eigen::Vector3d& axis,
                       double degrees_per_frame, int frames, int warmup, double warmup_ms) {
   if (frames < 1) throw std::invalid_argument("--frames must be >= 1");
+  if (warmup_ms < 0) warmup_ms = current_gl_info().software_rasterizer() ? 0.0 : 300.0;
   std::vector<double> total, cpu, gl;
   const auto warmup_start = Clock::now();
   for (int f = -warmup; f < frames; ++f) {

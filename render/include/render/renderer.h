@@ -200,7 +200,8 @@ class Renderer {
 // (so constants are recomputed every frame, inside the timing), each ended by glFinish. The
 // warm-up lasts at least `warmup_ms`: a GPU left idle during set-up (a grouping search) runs
 // its first tens of milliseconds of frames at idle clocks, which a median of a few fast frames
-// would take for the configuration's speed (docs/BENCHMARKS.md, "On a GPU").
+// would take for the configuration's speed (docs/BENCHMARKS.md, "On a GPU"). Negative: 300 ms
+// on a hardware GPU, none on a software rasteriser (whose clocks are the CPU's).
 struct TimingSummary {
   int frames = 0;
   double frame_ms_median = 0, cpu_ms_median = 0, gl_ms_median = 0;
