@@ -256,11 +256,6 @@ std::vector<Row> sweep_rows() {
   return rows;
 }
 
-// At least this long of frames before the timed ones (render::measure): on an H100 the same
-// row measured 2.3 ms a frame or 8.8 ms depending on how long the set-up before it had left
-// the GPU idle (the ILS grouping's seconds), with a 3-frame warm-up.
-constexpr double kWarmupMs = 300;
-
 using PassDetails = std::vector<std::pair<std::string, std::vector<render::PassWork>>>;
 
 // One row (feedback: multipass shading by feedback, the default; else in the triangle draws),
@@ -293,7 +288,7 @@ std::optional<Sample> run_row(const Scene& s, const Args& a, const Floors& floor
   const double cpu0 = process_cpu_ms();
   const render::TimingSummary t =
       render::measure(r, s.camera, s.lighting, Eigen::Matrix3d::Identity(),
-                      Eigen::Vector3d::UnitY(), 1.0, a.frames, 3, kWarmupMs);
+                      Eigen::Vector3d::UnitY(), 1.0, a.frames, 3);
   const double proc_ms = (process_cpu_ms() - cpu0) / (a.frames + 3);
   r.set_count_work(true);
   r.render(s.camera, s.lighting, Eigen::Matrix3d::Identity());

@@ -41,7 +41,8 @@ ViewLimits limits() {
   l.uncompressed = false;
   l.max_clusters = 100;
   l.max_components = 12;
-  l.floats_per_term = 48;  // order 4 glossy: 16 rows x 3 colours
+  l.launch_order = 4;  // glossy: 16 rows x 3 colours a term
+  l.launch_components = 2;
   l.max_order = 8;
   return l;
 }
@@ -192,7 +193,6 @@ TEST(ViewRequest, OtherCompressionsAreBoundedAndPriceTheirPasses) {
   // so the launch's 3 PCs cost 48 registers at order 4 where the budget of 100 fits 2.
   l.launch_order = 6;
   l.launch_components = 3;
-  l.floats_per_term = 108;
   l.max_order = 8;
   EXPECT_EQ(refusal({{"order", "4"}, {"budget", "100"}, {"cpp", "3"}}, l),
             "cpp=3: 2 clusters fit the budget of 100 registers; use 0 (all that fit) or 1 to 2");

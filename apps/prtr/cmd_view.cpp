@@ -203,8 +203,6 @@ void run(const Options& o, CLI::App*) {
   // The page may ask for up to 64 PCs; the compression refuses more than the data holds.
   served.limits.max_clusters = int(std::min<std::size_t>(mesh.vertex_count(), 65536));
   served.limits.max_components = 64;
-  served.limits.floats_per_term =
-      render::constant_layout(set.order, set.glossy(), 0).floats_per_cluster();
   // Orders past 8 make bakes of gigabytes for a mesh like the bunny (order 10: 1.4 GB).
   served.limits.max_order = std::max(set.order, std::min(8, prt::kMaxOrder));
   served.limits.launch_order = set.order;

@@ -327,23 +327,16 @@ void BakeEngine::finish() {
 }  // namespace detail
 
 TransferSet bake(const meshes::Mesh& mesh, const BakeOptions& o, BakeStats* stats) {
-  validate(o);  // before sizing the output from the options
-  TransferSet sized;
-  sized.kind = o.kind;
-  sized.order = o.order;
-  sized.channels = o.material.channels();
-  // The output's pages faulted in on every thread before the (then bandwidth-bound) zeroing:
-  // page faults on one thread were most of the bake's serial remainder (186 MB for the bunny
-  // at order 6).
-  std::vector<float> data;
-  const std::size_t floats = mesh.vertex_count() * sized.floats_per_vertex();
-  data.reserve(floats);
-  detail::populate_pages(data.data(), floats * sizeof(float));
-  data.resize(floats);
   BakeStats local_stats;
   detail::BakeEngine engine(mesh, o, stats ? *stats : local_stats);
   TransferSet out = engine.shape();
-  out.data = std::move(data);
+  // The output's pages faulted in on every thread before the (then bandwidth-bound) zeroing:
+  // page faults on one thread were most of the bake's serial remainder (186 MB for the bunny
+  // at order 6).
+  const std::size_t floats = engine.vertex_count() * engine.floats_per_vertex();
+  out.data.reserve(floats);
+  detail::populate_pages(out.data.data(), floats * sizeof(float));
+  out.data.resize(floats);
   std::vector<HitBlock> hits;
   const std::vector<std::uint32_t> all = detail::index_range(0, engine.vertex_count());
   engine.start_pass(0);

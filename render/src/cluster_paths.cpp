@@ -116,10 +116,7 @@ class ClusterPath : public RenderPath {
   // `legacy_sort`: the slot sort this path had before renumbering (renumber_vertices off).
   ClusterPath(const PathInput& in, bool split, bool per_cluster_aligned, bool sort_by_slot,
               bool pass_blocks, bool legacy_sort, bool zero_copies = false)
-      : constants_(*in.set),
-        layout_(constants_.layout()),
-        wanted_constants_(in.options.constants),
-        stats_(&in.stats) {
+      : constants_(*in.set), layout_(constants_.layout()) {
     const int per_pass = clusters_per_pass(in);
     plan_ = plan_slots(group(in, per_pass, split), in.set->cluster_count,
                        layout_.registers_per_cluster(), per_cluster_aligned);
@@ -159,9 +156,10 @@ class ClusterPath : public RenderPath {
 
  protected:
   // The per-vertex attributes, the index ranges (whole mesh, then `pass_lists`), and the
-  // constant buffer bound as `target`.
-  void upload(const std::vector<std::uint32_t>& cluster_attribute, GLenum target,
-              bool shaded_on_gpu) {
+  // constant buffer bound as `target`, written each frame on the GPU or from the CPU
+  // (in.options.constants, recorded in in.stats).
+  void upload(const PathInput& in, const std::vector<std::uint32_t>& cluster_attribute,
+              GLenum target, bool shaded_on_gpu) {
     whole_ = mesh_->add_all_triangles();
     for (const auto& list : pass_lists_) pass_ranges_.push_back(mesh_->add_indices(list));
     for (const auto& ids : pass_triangles_) pass_ranges_.push_back(mesh_->add_triangles(ids));
@@ -179,14 +177,14 @@ class ClusterPath : public RenderPath {
     mesh_->upload_indices();
     constant_target_ = target;
     constant_buffer_ = make_buffer(target, GLsizeiptr(host_.size() * 4), nullptr, GL_DYNAMIC_DRAW);
-    if (shaded_on_gpu && constants_on_gpu())
+    if (shaded_on_gpu && constants_on_gpu(in.options.constants))
       gpu_constants_ = std::make_unique<GpuConstants>(constants_, plan_.slot_of, host_.size());
-    stats_->constants = gpu_constants_ ? Constants::kGpu : Constants::kCpu;
+    in.stats.constants = gpu_constants_ ? Constants::kGpu : Constants::kCpu;
   }
 
   // kAuto (RendererOptions::constants): a hardware GPU whose storage blocks hold the rows.
-  bool constants_on_gpu() const {
-    if (wanted_constants_ != Constants::kAuto) return wanted_constants_ == Constants::kGpu;
+  bool constants_on_gpu(Constants wanted) const {
+    if (wanted != Constants::kAuto) return wanted == Constants::kGpu;
     const GlInfo info = current_gl_info();
     return !info.software_rasterizer() &&
            GpuConstants::row_bytes(constants_) <= std::size_t(std::max(info.max_ssbo_size, 0LL));
@@ -249,8 +247,6 @@ class ClusterPath : public RenderPath {
   std::vector<IndexRange> pass_ranges_;
   GLuint constant_buffer_ = 0;
   GLenum constant_target_ = GL_UNIFORM_BUFFER;
-  Constants wanted_constants_;
-  RenderStats* stats_;
   std::unique_ptr<GpuConstants> gpu_constants_;  // null: computed on the CPU and uploaded
 
  private:
@@ -342,7 +338,7 @@ class MultipassPath : public ClusterPath {
     std::vector<std::uint32_t> relative = slots();
     for (std::size_t i = 0; i < relative.size(); ++i)
       relative[i] -= std::uint32_t(plan_.pass_offset[pass_of_vertex_[i]] / cluster_bytes());
-    upload(relative, GL_UNIFORM_BUFFER, true);
+    upload(in, relative, GL_UNIFORM_BUFFER, true);
     depth_program_ =
         GlProgram("depth pre-pass", position_vertex_shader(), coverage_fragment_shader());
     if (feedback_)
@@ -450,7 +446,7 @@ class MultipassPath : public ClusterPath {
 class SinglepassPath : public ClusterPath {
  public:
   explicit SinglepassPath(const PathInput& in) : ClusterPath(in, false, false, false, false, true) {
-    upload(slots(), GL_SHADER_STORAGE_BUFFER, true);
+    upload(in, slots(), GL_SHADER_STORAGE_BUFFER, true);
     program_ = GlProgram("single-pass shading",
                          compressed_vertex_shader(layout_, ConstantAccess::kStorage, 0, false),
                          radiance_fragment_shader(), true);
@@ -467,7 +463,7 @@ class SinglepassPath : public ClusterPath {
 class DecoupledPath : public ClusterPath {
  public:
   explicit DecoupledPath(const PathInput& in) : ClusterPath(in, true, true, true, false, true) {
-    upload(slots(), GL_UNIFORM_BUFFER, true);
+    upload(in, slots(), GL_UNIFORM_BUFFER, true);
     ranges_ = cluster_ranges(mesh_->vertex_count());
     shade_program_ =
         GlProgram("decoupled shading",
@@ -496,7 +492,7 @@ class DecoupledPath : public ClusterPath {
 class CpuPath : public ClusterPath {
  public:
   explicit CpuPath(const PathInput& in) : ClusterPath(in, false, false, false, false, false) {
-    upload(slots(), GL_UNIFORM_BUFFER, false);
+    upload(in, slots(), GL_UNIFORM_BUFFER, false);
     program_ =
         GlProgram("pass-through", passthrough_vertex_shader(), radiance_fragment_shader(), true);
   }

@@ -62,7 +62,6 @@ GpuConstants::GpuConstants(const ShadingConstants& constants,
   if (total_floats > std::numeric_limits<std::uint32_t>::max())
     throw GlError("the constant buffer is too large for GPU constants; use --constants cpu");
   const ConstantLayout& lay = constants.layout();
-  const int channels = constants.channels();
   std::vector<float> rows;
   rows.reserve(bytes / sizeof(float));
   std::vector<std::uint32_t> sources(total_floats, kNoSource);
@@ -74,8 +73,7 @@ GpuConstants::GpuConstants(const ShadingConstants& constants,
     for (int t = 0; t < lay.terms; ++t)
       for (int c = 0; c < 3; ++c)
         for (int i = 0; i < lay.rows; ++i) {
-          const std::size_t row =
-              first_row + std::size_t((t * channels + (channels == 1 ? 0 : c)) * lay.rows + i);
+          const std::size_t row = first_row + std::size_t(constants.row(t, c, i));
           if (row >= (std::size_t(1) << 30))
             throw GlError("too many transfer rows for GPU constants; use --constants cpu");
           sources[base + std::size_t(lay.offset(t, c, i))] = std::uint32_t(row << 2 | c);

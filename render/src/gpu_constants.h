@@ -21,8 +21,8 @@ namespace render {
 
 class GpuConstants {
  public:
-  // `slot_of` and `stride_floats` as ShadingConstants::compute takes them; `total_floats` is
-  // the size of the constant buffer, every float of which each frame writes (gaps as zero).
+  // `slot_of` as ShadingConstants::compute takes it; `total_floats` is the size of the
+  // constant buffer, every float of which each frame writes (gaps as zero).
   // Throws GlError when the rows exceed the context's shader storage block size.
   GpuConstants(const ShadingConstants& constants, const std::vector<std::uint32_t>& slot_of,
                std::size_t total_floats);

@@ -76,7 +76,6 @@ void ShadingConstants::compute(const Eigen::Ref<const prt::ShLighting>& lighting
         "ShadingConstants::compute: slot_of must have one entry per cluster");
   const Eigen::Matrix<float, Eigen::Dynamic, 3> l = lighting.cast<float>();
   const ConstantLayout lay = layout_;
-  const int channels = channels_;
   tbb::parallel_for(
       tbb::blocked_range<int>(0, cluster_count_, 4), [&](const tbb::blocked_range<int>& range) {
         Eigen::Matrix<float, Eigen::Dynamic, 3> product;
@@ -84,11 +83,9 @@ void ShadingConstants::compute(const Eigen::Ref<const prt::ShLighting>& lighting
           product.noalias() = packed_[std::size_t(k)] * l;
           float* dst = out + std::size_t(slot_of[std::size_t(k)]) * lay.floats_stride();
           for (int t = 0; t < lay.terms; ++t)
-            for (int c = 0; c < 3; ++c) {
-              const int channel = channels == 1 ? 0 : c;
-              const Eigen::Index base = (Eigen::Index(t) * channels + channel) * lay.rows;
-              for (int i = 0; i < lay.rows; ++i) dst[lay.offset(t, c, i)] = product(base + i, c);
-            }
+            for (int c = 0; c < 3; ++c)
+              for (int i = 0; i < lay.rows; ++i)
+                dst[lay.offset(t, c, i)] = product(row(t, c, i), c);
           std::fill(dst + lay.floats_per_cluster(), dst + lay.floats_stride(), 0.f);
         }
       });

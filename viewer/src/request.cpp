@@ -2,6 +2,7 @@
 
 #include "cpca/supercluster_strategy.h"
 #include "render/pass_capacity.h"
+#include "render/shading.h"
 
 #include <algorithm>
 #include <cctype>
@@ -214,17 +215,12 @@ namespace {
 // decides (the renderer's own refusal names command-line flags), this says which values
 // would fit.
 void check_passes(const ViewState& state, const ViewLimits& limits) {
-  // Another order prices a term at its own rows (glossy: n^2 per colour).
-  const bool other_order = state.order > 0 && limits.launch_order > 0 && limits.glossy &&
-                           state.order != limits.launch_order;
-  const int floats_per_term = other_order ? limits.floats_per_term /
-                                                (limits.launch_order * limits.launch_order) *
-                                                state.order * state.order
-                                          : limits.floats_per_term;
-  const int pcs = state.pcs > 0 ? state.pcs : limits.launch_components;
-  const int cost = (state.pcs > 0 || other_order) && floats_per_term > 0
-                       ? ((pcs + 1) * floats_per_term + 3) / 4
-                       : limits.registers_per_cluster;
+  const bool other = (state.pcs > 0 || state.order > 0) && limits.launch_order > 0;
+  const int cost = other ? render::constant_layout(
+                               state.order > 0 ? state.order : limits.launch_order, limits.glossy,
+                               state.pcs > 0 ? state.pcs : limits.launch_components)
+                               .registers_per_cluster()
+                         : limits.registers_per_cluster;
   const render::PassCapacity c =
       render::check_pass_capacity(std::max(1, cost), state.register_budget,
                                   limits.max_register_budget, state.clusters_per_pass);

@@ -210,6 +210,6 @@ struct TimingSummary {
 TimingSummary measure(Renderer& renderer, const Camera& camera,
                       const Eigen::Ref<const prt::ShLighting>& lighting,
                       const Eigen::Matrix3d& start_rotation, const Eigen::Vector3d& axis,
-                      double degrees_per_frame, int frames, int warmup, double warmup_ms = 0);
+                      double degrees_per_frame, int frames, int warmup, double warmup_ms = -1);
 
 }  // namespace render

@@ -59,12 +59,16 @@ class ShadingConstants {
 
   const ConstantLayout& layout() const { return layout_; }
   int cluster_count() const { return cluster_count_; }
-  int channels() const { return channels_; }
   int coefficient_count() const { return order_ * order_; }
-  // Cluster k's transfer rows, (N + 1) * channels * rows x n, row-major: term t, channel c,
-  // row i is row (t * channels + c) * rows + i. Its constants are these rows times l.
+  // Cluster k's transfer rows, (N + 1) * channels * rows x n, row-major. Its constants are
+  // these rows times l: constant (term, colour, i) is row(term, colour, i) times column colour.
   const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>& rows(int k) const {
     return packed_[std::size_t(k)];
+  }
+  // Term t, channel c, row i is row (t * channels + c) * rows + i; a grey set's colours share
+  // their rows.
+  int row(int term, int colour, int i) const {
+    return (term * channels_ + (channels_ == 1 ? 0 : colour)) * layout_.rows + i;
   }
 
   // Writes cluster k's constants to out + slot_of[k] * layout().floats_stride() (padding

@@ -54,11 +54,11 @@ struct ViewLimits {
   int max_register_budget = 1 << 20;  // what the GL context offers
   int registers_per_cluster = 1;      // one cluster's constants; a budget below fits none
   // Other compressions the page may ask for (0: none): clusters up to max_clusters, PCs up to
-  // max_components, SH orders up to max_order (another order bakes first); one cluster then
-  // takes ceil((PCs + 1) * floats_per_term / 4) registers, floats_per_term being 3 n^2 at
-  // order n for glossy transfer (3 for diffuse).
-  int max_clusters = 0, max_components = 0, floats_per_term = 0, max_order = 0;
-  int launch_order = 0, launch_components = 0;  // floats_per_term is given at launch_order
+  // max_components, SH orders up to max_order (another order bakes first). A cluster of the
+  // asked-for PCs and order (the launch's where not asked; launch_order 0: not priced) takes
+  // the registers render::constant_layout gives it.
+  int max_clusters = 0, max_components = 0, max_order = 0;
+  int launch_order = 0, launch_components = 0;
   bool glossy = true;
 };
 
