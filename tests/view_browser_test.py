@@ -23,8 +23,12 @@ import view_support as vs  # noqa: E402
 CHROMIUM = "/usr/bin/chromium"
 
 # The displayed image's size, spread and a hash of its pixels, read back through a canvas.
-PIXELS = """(() => {
+# The page may have just given the image a newer frame's URL (the still view's 2 x 2 refinement
+# follows the first frame by itself), and until that decodes naturalWidth is 0: wait for it.
+PIXELS = """(async () => {
   const img = document.getElementById('frame');
+  for (let i = 0; i < 100 && !(img.complete && img.naturalWidth); ++i)
+    await img.decode().catch(() => new Promise((r) => setTimeout(r, 50)));
   if (!img.naturalWidth) return null;
   const c = document.createElement('canvas');
   c.width = img.naturalWidth; c.height = img.naturalHeight;
