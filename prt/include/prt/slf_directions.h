@@ -1,0 +1,35 @@
+// prt/slf_directions.h: the surface light field's grid of directions (SLF paper, Sec. 3.1).
+//
+// A surface light field stores exit radiance toward Z x W world-space directions over the
+// whole sphere, in the paper's latitude-longitude parameterisation (its Eqs. 1 and 2, after
+// Reinhard et al. 2010): xi1 in [0, 2] is the azimuth, xi2 in [0, 1] the polar angle from
+// world +Y,
+//   (theta, phi) = (pi (xi1 - 1), pi xi2)
+//   d = (sin phi sin theta, cos phi, -sin phi cos theta)
+// and back, xi1 = 1 + atan2(d.x, -d.z) / pi, xi2 = acos(d.y) / pi. The whole sphere rather
+// than each point's hemisphere, so the renderer never turns a view into a local frame.
+//
+// Direction (i, j), azimuth cell i in [0, Z) and polar cell j in [0, W), sits at its cell's
+// centre, xi1 = 2 (i + 0.5) / Z and xi2 = (j + 0.5) / W, and is column j Z + i of a row of
+// the SLF matrix (times three: RGB innermost, as render/slf_model.h lays out the view maps).
+#pragma once
+
+#include <Eigen/Core>
+
+namespace prt {
+
+struct SlfGrid {
+  int azimuth = 32;    // Z
+  int elevation = 16;  // W
+  int directions() const { return azimuth * elevation; }
+  void validate() const;  // both in [1, 4096]; std::invalid_argument naming the bad one
+};
+
+// Eq. 1: the unit direction at lat-long coordinates (xi1, xi2).
+Eigen::Vector3d slf_direction(double xi1, double xi2);
+// Eq. 2: (xi1, xi2) of a direction (need not be unit; zero gives (1, 0.5)).
+Eigen::Vector2d slf_coordinates(const Eigen::Vector3d& direction);
+// The centre of column j Z + i.
+Eigen::Vector3d slf_grid_direction(const SlfGrid& grid, int column);
+
+}  // namespace prt

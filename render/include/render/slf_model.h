@@ -1,0 +1,48 @@
+// render/slf_model.h: a compressed surface light field as the one-pass renderer reads it
+// (SLF paper, Secs. 3.2 and 3.3), in plain arrays so render/ needs no file format.
+//
+// Radiance leaving surface texel t toward grid direction d (prt/slf_directions.h), channel c:
+//   L(t, d, c) = V[cl, 0, d, c] + sum_{j < k} U[t, j] V[cl, 1 + j, d, c],  cl = cluster of t
+// which is CPCA's reconstruction, the cluster mean in slice 0 of the view maps and the
+// surface map holding the weights. A fragment reads the four texels around its atlas
+// coordinate (bilinear in space, each texel with its own cluster) and interpolates each
+// between the grid directions around the view.
+#pragma once
+
+#include "prt/slf_directions.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace render {
+
+struct SlfModel {
+  // Geometry, unwelded: corner 3 t + i of triangle t. The atlas gives every triangle its own
+  // texels, so corners shared in space have different texture coordinates.
+  std::vector<Eigen::Vector3f> positions;  // 3 T
+  std::vector<Eigen::Vector3f> normals;    // 3 T (shading the background-free floor, overlays)
+  std::vector<Eigen::Vector2f> uv;         // 3 T, atlas coordinates in [0, 1]^2 (texel centre
+                                           // x at (x + 0.5) / map_width)
+
+  int map_width = 0, map_height = 0;  // X x Y texels of the surface map
+  prt::SlfGrid grid;                  // Z x W directions
+  int components = 0;                 // k, PCA terms per cluster
+  int clusters = 0;                   // eta
+
+  std::vector<std::int32_t> texel_cluster;  // X Y, row-major (y * X + x); -1: no triangle reads it
+  std::vector<float> texel_weights;         // X Y k: the surface map U
+  // clusters (k + 1) Z W 3: cluster, slice (0 the mean, 1 + j component j), direction
+  // column j Z + i, then RGB. The view maps V.
+  std::vector<float> view_maps;
+
+  std::size_t slice_floats() const { return std::size_t(grid.directions()) * 3; }
+  const float* view_slice(int cluster, int slice) const {
+    return view_maps.data() + (std::size_t(cluster) * (components + 1) + slice) * slice_floats();
+  }
+  // Throws std::invalid_argument naming the first inconsistent size.
+  void validate() const;
+};
+
+}  // namespace render
