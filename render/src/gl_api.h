@@ -90,6 +90,7 @@
   X(glRenderbufferStorage)       \
   X(glShaderSource)              \
   X(glTexImage2D)                \
+  X(glTexImage3D)                \
   X(glTexParameteri)             \
   X(glTransformFeedbackVaryings) \
   X(glUniform1i)                 \
@@ -199,6 +200,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glRenderbufferStorage (::render::gl::current->glRenderbufferStorage)
 #define glShaderSource (::render::gl::current->glShaderSource)
 #define glTexImage2D (::render::gl::current->glTexImage2D)
+#define glTexImage3D (::render::gl::current->glTexImage3D)
 #define glTexParameteri (::render::gl::current->glTexParameteri)
 #define glTransformFeedbackVaryings (::render::gl::current->glTransformFeedbackVaryings)
 #define glUniform1i (::render::gl::current->glUniform1i)

@@ -1,0 +1,81 @@
+// render/slf_renderer.h: a compressed surface light field drawn in one GL pass (SLF paper,
+// Secs. 3.3 and 4): per fragment, the four surface-map texels around the atlas coordinate,
+// each reconstructed in its own cluster from that cluster's view maps at the view direction,
+// bilinear in space and in direction exactly as render/slf_reference.h computes it on the CPU
+// (tests hold the two to float rounding). No super-clusters: a fragment can read any cluster,
+// so every triangle is drawn once.
+//
+// Textures: the cluster id per texel (R32I, fetched); the surface map's weights (RGBA32F
+// array, four components a layer); the view maps as one RGBA32F array with a layer per slice
+// (0 the mean, 1 + j component j) whose layers tile the clusters' Z x W maps, each tile with
+// a one-texel gutter (azimuth wrapped around, poles clamped) so that the hardware's bilinear
+// filter interpolates direction, seam included, in one fetch per texel and slice. A tile's
+// corner follows from the cluster id by arithmetic (a division by the tiles per row), which
+// costs less than the dependent fetch of the paper's cluster-map texture. Where the four
+// texels share a cluster (all but the fragments along cluster borders), the weights are
+// interpolated first (filtered fetches of the surface map) and the cluster's k + 1 slices
+// are read once: k + 1 view fetches instead of 4 (k + 1), the same sum by linearity.
+//
+// Precision: on Mesa's rasterisers the filter weights are single floats; a hardware GPU's
+// texture units may quantise them (8 fractional bits on many), which rounds the
+// interpolation between neighbouring directions by up to 1/512 of their difference.
+#pragma once
+
+#include "probes/probe.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/slf_model.h"
+
+#include <memory>
+
+namespace render {
+
+struct SlfRendererOptions {
+  bool cull_back_faces = true;  // closed meshes; the SLF of a face seen from behind is not stored
+  // Interpolate the weights first where the four texels share a cluster (see above); false
+  // reconstructs all four texels everywhere, to measure the difference.
+  bool shared_cluster_fast_path = true;
+};
+
+class SlfRenderer {
+ public:
+  // Needs a current GL 4.5 context (render/gl_context.h). The model is validated and uploaded
+  // (not kept). `probe` (may be null) is the background, drawn unrotated: the light field was
+  // computed under the probe as it is, so turning the environment would not relight it.
+  // GlError when a texture exceeds the context's limits (the message names the size).
+  SlfRenderer(const SlfModel& model, const probes::Probe* probe,
+              const SlfRendererOptions& options = {});
+  ~SlfRenderer();
+  SlfRenderer(const SlfRenderer&) = delete;
+  SlfRenderer& operator=(const SlfRenderer&) = delete;
+
+  // The probe (when there is one and use_probe is set) or the solid colour behind the mesh.
+  void set_background(const Background& background);
+  void set_probe(const probes::Probe* probe);
+  void set_options(const SlfRendererOptions& options);
+
+  // Draws one frame (background, then the mesh in one pass; waits with glFinish).
+  FrameTiming render(const Camera& camera);
+  // The last frame, linear RGB radiance, alpha coverage, row 0 at the top.
+  Image read_image() const;
+  void read_image(Image& into) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+struct SlfImageOptions {
+  SlfRendererOptions renderer{};
+  Background background{};  // use_probe: the probe passed in, when not null
+  int supersample = 1;      // render at this factor per side and box-filter back (>= 1)
+};
+
+// "Render this model from this camera": one frame into a linear HDR image (RGB radiance,
+// alpha coverage). Needs a current GL context. std::invalid_argument for a bad camera,
+// model or supersampling factor.
+Image render_slf_image(const SlfModel& model, const Camera& camera, const probes::Probe* probe,
+                       const SlfImageOptions& options = {});
+
+}  // namespace render

@@ -1,0 +1,432 @@
+#include "render/slf_renderer.h"
+
+#include "background_pass.h"
+#include "frame_target.h"
+#include "gl_program.h"
+#include "render/gl_context.h"
+#include "render/supersample.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace render {
+
+namespace slf_gl {
+
+// Texture units, fixed in the shader's layout(binding) qualifiers.
+constexpr int kClusterUnit = 0, kViewsUnit = 1, kWeightsUnit = 2;
+
+// How the clusters' view maps tile one layer of the view-map array.
+struct TileLayout {
+  int tile_width = 0, tile_height = 0;  // Z + 2, W + 2 (the gutter)
+  int columns = 0, rows = 0;            // tiles per row, rows of tiles
+  int width() const { return columns * tile_width; }
+  int height() const { return rows * tile_height; }
+};
+
+int gl_integer(GLenum name) {
+  GLint value = 0;
+  glGetIntegerv(name, &value);
+  return value;
+}
+
+// Near-square, within the context's texture size.
+TileLayout tile_layout(const SlfModel& model, int max_size) {
+  TileLayout t;
+  t.tile_width = model.grid.azimuth + 2;
+  t.tile_height = model.grid.elevation + 2;
+  const int square = int(std::ceil(std::sqrt(double(model.clusters))));
+  t.columns = std::max(1, std::min(square, max_size / t.tile_width));
+  t.rows = (model.clusters + t.columns - 1) / t.columns;
+  if (t.width() > max_size || t.height() > max_size) {
+    std::string message = "surface light field: ";
+    message += std::to_string(model.clusters);
+    message += " clusters of ";
+    message += std::to_string(model.grid.azimuth);
+    message += " x ";
+    message += std::to_string(model.grid.elevation);
+    message += " view maps need a ";
+    message += std::to_string(t.width());
+    message += " x ";
+    message += std::to_string(t.height());
+    message += " texture; this context allows ";
+    message += std::to_string(max_size);
+    message += " per side: use fewer clusters or directions";
+    throw GlError(message);
+  }
+  return t;
+}
+
+std::string float_literal(double value) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.9g", value);
+  std::string s(buf);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string vertex_shader() {
+  return "#version 450 core\n"
+         "layout(location = 0) in vec3 a_position;\n"
+         "layout(location = 1) in vec2 a_uv;\n"
+         "uniform mat4 u_clip_from_world;\n"
+         "out vec3 v_world;\n"
+         "out vec2 v_uv;\n"
+         "void main() {\n"
+         "  v_world = a_position;\n"
+         "  v_uv = a_uv;\n"
+         "  gl_Position = u_clip_from_world * vec4(a_position, 1.0);\n"
+         "}\n";
+}
+
+// Every size is a literal, and the sums over components are written out, so the compiler
+// sees constant layer indices (llvmpipe runs such code markedly faster than loops over
+// uniforms, render/shader_source.h). textureLod throughout: the fetches sit in non-uniform
+// control flow, where implicit derivatives are undefined, and there are no mipmaps.
+std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool fast_path) {
+  const int k = model.components;
+  std::string s = "#version 450 core\n";
+  s += "in vec3 v_world;\nin vec2 v_uv;\n";
+  s += "layout(location = 0) out vec4 o_colour;\n";
+  s += "uniform vec3 u_eye;\n";
+  s += "layout(binding = " + std::to_string(kClusterUnit) + ") uniform isampler2D u_cluster;\n";
+  s += "layout(binding = " + std::to_string(kViewsUnit) + ") uniform sampler2DArray u_views;\n";
+  if (k > 0)
+    s += "layout(binding = " + std::to_string(kWeightsUnit) +
+         ") uniform sampler2DArray u_weights;\n";
+  s += "const vec2 kMap = vec2(" + float_literal(model.map_width) + ", " +
+       float_literal(model.map_height) + ");\n";
+  s += "const ivec2 kMapMax = ivec2(" + std::to_string(model.map_width - 1) + ", " +
+       std::to_string(model.map_height - 1) + ");\n";
+  s += "const vec2 kTile = vec2(" + float_literal(tiles.tile_width) + ", " +
+       float_literal(tiles.tile_height) + ");\n";
+  s += "const vec2 kAtlasScale = vec2(" + float_literal(1.0 / tiles.width()) + ", " +
+       float_literal(1.0 / tiles.height()) + ");\n";
+  s += "const int kTileColumns = " + std::to_string(tiles.columns) + ";\n";
+  // Where (xi1, xi2) falls in a tile, in texels: column i's centre at 1 + i + 0.5.
+  s += "const vec2 kGridScale = vec2(" + float_literal(0.5 * model.grid.azimuth) + ", " +
+       float_literal(model.grid.elevation) + ");\n";
+  s += "const float kInvPi = " + float_literal(1.0 / 3.14159265358979323846) + ";\n";
+  s += "vec2 view_coord(int c, vec2 p) {\n"
+       "  return (vec2(c % kTileColumns, c / kTileColumns) * kTile + p) * kAtlasScale;\n"
+       "}\n";
+  // The k + 1 slices of cluster c at p, weighted by the weights in u0, u1, ...
+  auto sum = [&](const std::string& weights_prefix) {
+    std::string body = "  vec3 l = textureLod(u_views, vec3(q, 0.0), 0.0).rgb;\n";
+    for (int j = 0; j < k; ++j) {
+      body += "  l += " + weights_prefix + std::to_string(j / 4) + "." + "xyzw"[j % 4] +
+              " * textureLod(u_views, vec3(q, " + float_literal(1 + j) + "), 0.0).rgb;\n";
+    }
+    return body;
+  };
+  s += "vec3 texel_radiance(int c, ivec2 t, vec2 p) {\n  vec2 q = view_coord(c, p);\n";
+  for (int l = 0; l < (k + 3) / 4; ++l)
+    s += "  vec4 u" + std::to_string(l) + " = texelFetch(u_weights, ivec3(t, " + std::to_string(l) +
+         "), 0);\n";
+  s += sum("u");
+  s += "  return l;\n}\n";
+  if (fast_path) {
+    s += "vec3 shared_radiance(int c, vec2 p) {\n  vec2 q = view_coord(c, p);\n";
+    for (int l = 0; l < (k + 3) / 4; ++l)
+      s += "  vec4 u" + std::to_string(l) + " = textureLod(u_weights, vec3(v_uv, " +
+           float_literal(l) + "), 0.0);\n";
+    s += sum("u");
+    s += "  return l;\n}\n";
+  }
+  s += "void main() {\n"
+       "  vec3 d = normalize(u_eye - v_world);\n"
+       // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
+       "  float azimuth = (d.x == 0.0 && d.z == 0.0) ? 0.0 : atan(d.x, -d.z);\n"
+       "  vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(d.y, -1.0, 1.0)) * kInvPi);\n"
+       "  vec2 p = vec2(1.0) + xi * kGridScale;\n"
+       "  vec2 st = v_uv * kMap - 0.5;\n"
+       "  vec2 b = floor(st);\n"
+       "  vec2 f = st - b;\n"
+       "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
+       "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
+       "  int c00 = texelFetch(u_cluster, lo, 0).r;\n"
+       "  int c10 = texelFetch(u_cluster, ivec2(hi.x, lo.y), 0).r;\n"
+       "  int c01 = texelFetch(u_cluster, ivec2(lo.x, hi.y), 0).r;\n"
+       "  int c11 = texelFetch(u_cluster, hi, 0).r;\n"
+       "  vec3 l = vec3(0.0);\n";
+  const char* general =
+      "    float w00 = (1.0 - f.x) * (1.0 - f.y), w10 = f.x * (1.0 - f.y);\n"
+      "    float w01 = (1.0 - f.x) * f.y, w11 = f.x * f.y;\n"
+      "    if (c00 >= 0 && w00 > 0.0) l += w00 * texel_radiance(c00, lo, p);\n"
+      "    if (c10 >= 0 && w10 > 0.0) l += w10 * texel_radiance(c10, ivec2(hi.x, lo.y), p);\n"
+      "    if (c01 >= 0 && w01 > 0.0) l += w01 * texel_radiance(c01, ivec2(lo.x, hi.y), p);\n"
+      "    if (c11 >= 0 && w11 > 0.0) l += w11 * texel_radiance(c11, hi, p);\n";
+  if (fast_path) {
+    s += "  if (c00 >= 0 && c00 == c10 && c00 == c01 && c00 == c11) {\n"
+         "    l = shared_radiance(c00, p);\n"
+         "  } else {\n";
+    s += general;
+    s += "  }\n";
+  } else {
+    s += "  {\n";
+    s += general;
+    s += "  }\n";
+  }
+  s += "  o_colour = vec4(l, 1.0);\n}\n";
+  return s;
+}
+
+void texture_parameters(GLenum target, GLint filter) {
+  glTexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
+  glTexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
+  glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
+  glTexParameteri(target, GL_TEXTURE_MAX_LEVEL, 0);
+}
+
+}  // namespace slf_gl
+
+struct SlfRenderer::Impl {
+  Impl(const SlfModel& model, const probes::Probe* probe, const SlfRendererOptions& options);
+  ~Impl();
+  void build_program();
+  void draw(const Camera& camera);
+
+  SlfRendererOptions options;
+  SlfModel shape;  // sizes only (the arrays are uploaded and dropped)
+  slf_gl::TileLayout tiles;
+  GLuint vao = 0, vbo = 0, cluster_texture = 0, views_texture = 0, weights_texture = 0;
+  GLsizei vertex_count = 0;
+  GlProgram program;
+  BackgroundPass background_pass;
+  Background background;
+  FrameTarget target;
+};
+
+SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
+                        const SlfRendererOptions& renderer_options)
+    : options(renderer_options), background_pass(probe) {
+  model.validate();
+  shape.map_width = model.map_width;
+  shape.map_height = model.map_height;
+  shape.grid = model.grid;
+  shape.components = model.components;
+  shape.clusters = model.clusters;
+  const int max_size = slf_gl::gl_integer(GL_MAX_TEXTURE_SIZE);
+  const int max_layers = slf_gl::gl_integer(GL_MAX_ARRAY_TEXTURE_LAYERS);
+  if (model.map_width > max_size || model.map_height > max_size)
+    throw GlError("surface light field: the " + std::to_string(model.map_width) + " x " +
+                  std::to_string(model.map_height) + " surface map exceeds this context's " +
+                  std::to_string(max_size) + " texels per side");
+  if (model.components + 1 > max_layers)
+    throw GlError("surface light field: " + std::to_string(model.components) + " components need " +
+                  std::to_string(model.components + 1) + " texture layers; this context allows " +
+                  std::to_string(max_layers));
+  tiles = slf_gl::tile_layout(model, max_size);
+
+  // Geometry: position and atlas coordinate per corner, drawn as triangles in order.
+  std::vector<float> vertices;
+  vertices.reserve(model.positions.size() * 5);
+  for (std::size_t i = 0; i < model.positions.size(); ++i) {
+    vertices.insert(vertices.end(), model.positions[i].data(), model.positions[i].data() + 3);
+    vertices.insert(vertices.end(), model.uv[i].data(), model.uv[i].data() + 2);
+  }
+  vertex_count = GLsizei(model.positions.size());
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glGenBuffers(1, &vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(float)), vertices.data(),
+               GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 5 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 5 * sizeof(float),
+                        reinterpret_cast<const void*>(3 * sizeof(float)));
+  glBindVertexArray(0);
+
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  const int x_size = model.map_width, y_size = model.map_height;
+  const std::size_t texels = std::size_t(x_size) * std::size_t(y_size);
+  // Integer textures must be sampled NEAREST (otherwise incomplete); texelFetch ignores it.
+  glGenTextures(1, &cluster_texture);
+  glBindTexture(GL_TEXTURE_2D, cluster_texture);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_R32I, x_size, y_size, 0, GL_RED_INTEGER, GL_INT,
+               model.texel_cluster.data());
+  slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
+
+  const int k = model.components;
+  if (k > 0) {
+    const int layers = (k + 3) / 4;
+    std::vector<float> weights(texels * 4 * std::size_t(layers), 0.f);
+    for (std::size_t t = 0; t < texels; ++t) {
+      if (model.texel_cluster[t] < 0) continue;  // zero, whatever the model holds
+      for (int j = 0; j < k; ++j)
+        weights[(std::size_t(j / 4) * texels + t) * 4 + std::size_t(j % 4)] =
+            model.texel_weights[t * std::size_t(k) + std::size_t(j)];
+    }
+    glGenTextures(1, &weights_texture);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, weights_texture);
+    glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, x_size, y_size, layers, 0, GL_RGBA, GL_FLOAT,
+                 weights.data());
+    slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_LINEAR);
+  }
+
+  // View maps: layer s holds slice s of every cluster, cluster c's tile at
+  // (c % columns, c / columns); inside a tile, texel (1 + i, 1 + j) is direction (i, j), the
+  // columns 0 and Z + 1 repeat directions Z - 1 and 0 (the azimuth wraps around) and the rows
+  // 0 and W + 1 repeat rows 0 and W - 1 (the poles clamp).
+  const int z = model.grid.azimuth, w = model.grid.elevation;
+  const std::size_t layer_texels = std::size_t(tiles.width()) * std::size_t(tiles.height());
+  std::vector<float> views(layer_texels * 4 * std::size_t(k + 1), 0.f);
+  for (int slice = 0; slice <= k; ++slice)
+    for (int c = 0; c < model.clusters; ++c) {
+      const float* v = model.view_slice(c, slice);
+      const int x0 = (c % tiles.columns) * tiles.tile_width;
+      const int y0 = (c / tiles.columns) * tiles.tile_height;
+      for (int ty = 0; ty < tiles.tile_height; ++ty) {
+        const int j = std::clamp(ty - 1, 0, w - 1);
+        for (int tx = 0; tx < tiles.tile_width; ++tx) {
+          const int i = (tx - 1 + z) % z;
+          const float* rgb = v + (std::size_t(j) * std::size_t(z) + std::size_t(i)) * 3;
+          float* out = views.data() +
+                       (std::size_t(slice) * layer_texels +
+                        std::size_t(y0 + ty) * std::size_t(tiles.width()) + std::size_t(x0 + tx)) *
+                           4;
+          out[0] = rgb[0];
+          out[1] = rgb[1];
+          out[2] = rgb[2];
+          out[3] = 1.f;
+        }
+      }
+    }
+  glGenTextures(1, &views_texture);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, views_texture);
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, tiles.width(), tiles.height(), k + 1, 0, GL_RGBA,
+               GL_FLOAT, views.data());
+  slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_LINEAR);
+  check_gl("SlfRenderer: textures");
+
+  build_program();
+  background.use_probe = background_pass.has_probe();
+  check_gl("SlfRenderer: set-up");
+}
+
+void SlfRenderer::Impl::build_program() {
+  program = GlProgram("surface light field", slf_gl::vertex_shader(),
+                      slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path));
+}
+
+SlfRenderer::Impl::~Impl() {
+  glDeleteBuffers(1, &vbo);
+  glDeleteVertexArrays(1, &vao);
+  glDeleteTextures(1, &cluster_texture);
+  glDeleteTextures(1, &views_texture);
+  if (weights_texture) glDeleteTextures(1, &weights_texture);
+}
+
+void SlfRenderer::Impl::draw(const Camera& camera) {
+  target.bind(camera.width, camera.height);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glDepthMask(GL_TRUE);
+  glClearDepth(1.0);
+  // As the PRT renderer: a probe background replaces the colour clear (alpha 0).
+  if (background.use_probe && background_pass.has_probe()) {
+    glClear(GL_DEPTH_BUFFER_BIT);
+    background_pass.draw(camera, Eigen::Matrix3d::Identity());
+    glDepthMask(GL_TRUE);
+  } else {
+    glClearColor(background.colour.x(), background.colour.y(), background.colour.z(), 0.f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  }
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_BLEND);
+  if (options.cull_back_faces) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
+  program.use();
+  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
+  glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
+  const Eigen::Vector3f eye = camera.eye.cast<float>();
+  glUniform3f(program.uniform("u_eye"), eye.x(), eye.y(), eye.z());
+  glActiveTexture(GL_TEXTURE0 + slf_gl::kClusterUnit);
+  glBindTexture(GL_TEXTURE_2D, cluster_texture);
+  glActiveTexture(GL_TEXTURE0 + slf_gl::kViewsUnit);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, views_texture);
+  if (weights_texture) {
+    glActiveTexture(GL_TEXTURE0 + slf_gl::kWeightsUnit);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, weights_texture);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glBindVertexArray(vao);
+  glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+  glBindVertexArray(0);
+  glDisable(GL_CULL_FACE);
+}
+
+SlfRenderer::SlfRenderer(const SlfModel& model, const probes::Probe* probe,
+                         const SlfRendererOptions& options)
+    : impl_(std::make_unique<Impl>(model, probe, options)) {}
+
+SlfRenderer::~SlfRenderer() = default;
+
+void SlfRenderer::set_background(const Background& background) {
+  impl_->background = background;
+}
+
+void SlfRenderer::set_probe(const probes::Probe* probe) {
+  impl_->background_pass.set_probe(probe);
+}
+
+void SlfRenderer::set_options(const SlfRendererOptions& options) {
+  const bool rebuild = options.shared_cluster_fast_path != impl_->options.shared_cluster_fast_path;
+  impl_->options = options;
+  if (rebuild) impl_->build_program();
+}
+
+FrameTiming SlfRenderer::render(const Camera& camera) {
+  camera.validate();
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  impl_->draw(camera);
+  glFinish();
+  FrameTiming timing;
+  timing.gl_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  timing.total_ms = timing.gl_ms;
+  check_gl("SlfRenderer::render");
+  return timing;
+}
+
+Image SlfRenderer::read_image() const {
+  Image image;
+  read_image(image);
+  return image;
+}
+
+void SlfRenderer::read_image(Image& into) const {
+  if (impl_->target.empty())
+    throw GlError("SlfRenderer::read_image: nothing rendered yet; call render() first");
+  impl_->target.read(into);
+}
+
+Image render_slf_image(const SlfModel& model, const Camera& camera, const probes::Probe* probe,
+                       const SlfImageOptions& options) {
+  camera.validate();
+  const Camera big = supersampled(camera, options.supersample);
+  SlfRenderer renderer(model, probe, options.renderer);
+  Background background = options.background;
+  background.use_probe = background.use_probe && probe != nullptr;
+  renderer.set_background(background);
+  renderer.render(big);
+  Image image = renderer.read_image();
+  if (options.supersample == 1) return image;
+  return box_downsample(image, options.supersample);
+}
+
+}  // namespace render
