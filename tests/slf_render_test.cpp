@@ -1,0 +1,495 @@
+// The surface light field's renderer: the model's checks, the builder from a compressed set,
+// the CPU reconstruction against analytic answers, and the one-pass GL image against the CPU
+// reference (under OSMesa, and again under EGL through the ".egl" copies of these tests).
+#include "render/slf_from_compressed.h"
+#include "render/slf_model.h"
+#include "render/slf_reference.h"
+#include "render/slf_renderer.h"
+
+#include "probes/procedural.h"
+#include "render/gl_context.h"
+#include "render/supersample.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Eigen::Vector2f;
+using Eigen::Vector3d;
+using Eigen::Vector3f;
+
+// A quad p0 p1 p2 p3 (counter-clockwise seen from the front) as two triangles sharing one
+// chart: uv runs linearly over [uv0, uv1]^2, so the surface map is continuous across the
+// diagonal and either triangle gives the same lookup there.
+void add_quad(render::SlfModel& m, const Vector3f& p0, const Vector3f& p1, const Vector3f& p2,
+              const Vector3f& p3, const Vector2f& uv0, const Vector2f& uv1) {
+  const Vector3f n = (p1 - p0).cross(p3 - p0).normalized();
+  const Vector3f p[4] = {p0, p1, p2, p3};
+  const Vector2f t[4] = {uv0, {uv1.x(), uv0.y()}, uv1, {uv0.x(), uv1.y()}};
+  for (int i : {0, 1, 2, 0, 2, 3}) {
+    m.positions.push_back(p[i]);
+    m.normals.push_back(n);
+    m.uv.push_back(t[i]);
+  }
+}
+
+using ClusterOf = std::function<int(int x, int y)>;
+using WeightOf = std::function<float(int x, int y, int j)>;
+// Cluster c, slice s, grid direction (column i, row j), channel.
+using ViewOf = std::function<float(int c, int s, int i, int j, int channel)>;
+
+void fill_maps(render::SlfModel& m, const ClusterOf& cluster, const WeightOf& weight,
+               const ViewOf& view) {
+  const int k = m.components;
+  m.texel_cluster.resize(std::size_t(m.map_width) * m.map_height);
+  m.texel_weights.resize(m.texel_cluster.size() * std::size_t(k));
+  for (int y = 0; y < m.map_height; ++y)
+    for (int x = 0; x < m.map_width; ++x) {
+      const std::size_t t = std::size_t(y) * m.map_width + x;
+      m.texel_cluster[t] = cluster(x, y);
+      for (int j = 0; j < k; ++j) m.texel_weights[t * k + j] = weight(x, y, j);
+    }
+  m.view_maps.resize(std::size_t(m.clusters) * (k + 1) * m.slice_floats());
+  for (int c = 0; c < m.clusters; ++c)
+    for (int s = 0; s <= k; ++s)
+      for (int j = 0; j < m.grid.elevation; ++j)
+        for (int i = 0; i < m.grid.azimuth; ++i)
+          for (int ch = 0; ch < 3; ++ch)
+            m.view_maps[((std::size_t(c) * (k + 1) + s) * m.grid.directions() +
+                         std::size_t(j) * m.grid.azimuth + i) *
+                            3 +
+                        ch] = view(c, s, i, j, ch);
+}
+
+render::SlfModel one_quad_model(int x_size, int y_size, prt::SlfGrid grid, int k, int clusters) {
+  render::SlfModel m;
+  add_quad(m, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0}, {1, 1});
+  m.map_width = x_size;
+  m.map_height = y_size;
+  m.grid = grid;
+  m.components = k;
+  m.clusters = clusters;
+  return m;
+}
+
+Vector3d random_direction(std::mt19937& rng) {
+  std::normal_distribution<double> g;
+  Vector3d d;
+  do d = Vector3d(g(rng), g(rng), g(rng));
+  while (d.norm() < 1e-3);
+  return d.normalized();
+}
+
+// --- The model's checks --------------------------------------------------------------------
+
+render::SlfModel valid_model() {
+  render::SlfModel m = one_quad_model(4, 3, {4, 2}, 2, 3);
+  fill_maps(
+      m, [](int x, int y) { return (x + y) % 4 - 1; },  // -1 (unused) .. 2
+      [](int x, int y, int j) { return float(x - y + j); },
+      [](int c, int s, int i, int j, int ch) { return float(c + s + i + j + ch); });
+  return m;
+}
+
+void expect_refused(const render::SlfModel& m, const std::string& names) {
+  try {
+    m.validate();
+    ADD_FAILURE() << "accepted a model with a bad " << names;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(names), std::string::npos)
+        << "the message does not name " << names << ": " << e.what();
+  }
+}
+
+TEST(SlfModel, ValidateAcceptsAConsistentModel) {
+  EXPECT_NO_THROW(valid_model().validate());
+}
+
+TEST(SlfModel, ValidateRefusesEachInconsistentSize) {
+  using M = render::SlfModel;
+  const std::vector<std::pair<std::string, std::function<void(M&)>>> cases = {
+      {"positions", [](M& m) { m.positions.clear(); }},
+      {"positions", [](M& m) { m.positions.pop_back(); }},
+      {"normals", [](M& m) { m.normals.pop_back(); }},
+      {"uv", [](M& m) { m.uv.push_back(Vector2f::Zero()); }},
+      {"uv", [](M& m) { m.uv[2] = Vector2f(1.5f, 0.f); }},
+      {"surface map", [](M& m) { m.map_width = 0; }},
+      {"azimuth", [](M& m) { m.grid.azimuth = 0; }},
+      {"elevation", [](M& m) { m.grid.elevation = 5000; }},
+      {"components", [](M& m) { m.components = -1; }},
+      {"clusters", [](M& m) { m.clusters = 0; }},
+      {"texel_cluster", [](M& m) { m.texel_cluster.pop_back(); }},
+      {"texel_weights", [](M& m) { m.texel_weights.push_back(0.f); }},
+      {"view_maps", [](M& m) { m.view_maps.pop_back(); }},
+      // The arrays sized for other k, X or eta.
+      {"texel_weights", [](M& m) { m.components = 3; }},
+      {"texel_cluster", [](M& m) { m.map_height = 4; }},
+      {"view_maps", [](M& m) { m.clusters = 4; }},
+      {"view_maps", [](M& m) { m.grid.azimuth = 5; }},
+      {"cluster 3", [](M& m) { m.texel_cluster[5] = 3; }},
+      {"cluster -2", [](M& m) { m.texel_cluster[5] = -2; }},
+      {"texel_weights[7]", [](M& m) { m.texel_weights[7] = std::nanf(""); }},
+      {"view_maps[11]", [](M& m) { m.view_maps[11] = INFINITY; }},
+      {"corner 4", [](M& m) { m.positions[4].x() = std::nanf(""); }},
+  };
+  for (const auto& [names, spoil] : cases) {
+    render::SlfModel m = valid_model();
+    spoil(m);
+    expect_refused(m, names);
+  }
+}
+
+// --- The CPU reconstruction against analytic answers -----------------------------------------
+
+// k = 0, one texel: the radiance is the view map alone. Red is the row centre's polar
+// coordinate xi2 (linear in the row, so bilinear interpolation returns xi2 itself between
+// the first and last row centres, and clamps beyond); green is the column index, which the
+// interpolation wraps from the last column back to column 0 across the seam xi1 = 0 = 2.
+TEST(SlfReference, ViewMapIsInterpolatedBilinearlyWithWrapAndPoleClamp) {
+  const prt::SlfGrid grid{12, 7};
+  render::SlfModel m = one_quad_model(1, 1, grid, 0, 1);
+  fill_maps(
+      m, [](int, int) { return 0; }, [](int, int, int) { return 0.f; },
+      [&](int, int, int i, int j, int ch) {
+        return ch == 0 ? float((j + 0.5) / grid.elevation) : ch == 1 ? float(i) : 2.f;
+      });
+  m.validate();
+  std::mt19937 rng(7);
+  const double z = grid.azimuth, w = grid.elevation;
+  auto expected = [&](const Vector3d& d) {
+    const Eigen::Vector2d xi = prt::slf_coordinates(d);
+    const double red = std::clamp(xi.y(), 0.5 / w, 1.0 - 0.5 / w);
+    const double s = xi.x() * z / 2 - 0.5;
+    double green = s;
+    if (s < 0) green = (z - 1) * -s;                         // column Z - 1 toward 0
+    if (s > z - 1) green = (z - 1) * (1.0 - (s - (z - 1)));  // and again past the last
+    return Vector3d(red, green, 2.0);
+  };
+  for (int n = 0; n < 2000; ++n) {
+    const Vector3d d = random_direction(rng);
+    const Vector3f got = render::slf_radiance(m, {0.3f, 0.6f}, d);
+    EXPECT_LT((got.cast<double>() - expected(d)).cwiseAbs().maxCoeff(), 2e-6)
+        << "direction " << d.transpose();
+  }
+  // Exactly at a grid direction the stored value comes back; exactly on the seam, the mean of
+  // the last and the first column.
+  for (int column = 0; column < grid.directions(); ++column) {
+    const Vector3f got =
+        render::slf_radiance(m, {0.5f, 0.5f}, prt::slf_grid_direction(grid, column));
+    EXPECT_NEAR(got.y(), float(column % grid.azimuth), 1e-4f);
+  }
+  const Vector3d seam = prt::slf_direction(0.0, 0.5);
+  EXPECT_NEAR(render::slf_radiance(m, {0.5f, 0.5f}, seam).y(), (z - 1) / 2, 1e-4);
+}
+
+// k = 1, one cluster, view maps constant in direction (mean c, the component 1): the radiance
+// is c + the bilinear interpolation of the weights, here linear in the texel index, so
+// c + 0.1 (u X - 1/2) + 0.2 (v Y - 1/2) inside the texel centres, whatever the direction.
+TEST(SlfReference, RadianceVaryingOnlyAcrossTheSurfaceIsBilinearInSpace) {
+  render::SlfModel m = one_quad_model(9, 5, {6, 4}, 1, 1);
+  fill_maps(
+      m, [](int, int) { return 0; }, [](int x, int y, int) { return 0.1f * x + 0.2f * y; },
+      [](int, int s, int, int, int ch) { return s == 0 ? 0.25f * (ch + 1) : 1.f; });
+  m.validate();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.5f / 9, 1.f - 0.5f / 9), v(0.5f / 5, 1.f - 0.5f / 5);
+  for (int n = 0; n < 500; ++n) {
+    const Vector2f uv(u(rng), v(rng));
+    const double spatial = 0.1 * (uv.x() * 9 - 0.5) + 0.2 * (uv.y() * 5 - 0.5);
+    const Vector3f got = render::slf_radiance(m, uv, random_direction(rng));
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(got[ch], 0.25 * (ch + 1) + spatial, 2e-6);
+  }
+  // Beyond the outer texel centres the map clamps: the border texel's value.
+  EXPECT_NEAR(render::slf_radiance(m, {0.f, 0.f}, Vector3d::UnitZ()).x(), 0.25, 1e-6);
+  EXPECT_NEAR(render::slf_radiance(m, {1.f, 1.f}, Vector3d::UnitZ()).x(), 0.25 + 0.8 + 0.8, 1e-6);
+}
+
+// Each texel is reconstructed in its own cluster: a checkerboard of two clusters whose means
+// are 1 and 3 (k = 0) gives the bilinear blend of the two values by the texels' weights, and
+// an unused texel contributes nothing (its weight is not handed to the others).
+TEST(SlfReference, EachTexelUsesItsOwnClusterAndUnusedTexelsWeighNothing) {
+  render::SlfModel m = one_quad_model(4, 4, {4, 2}, 0, 2);
+  fill_maps(
+      m, [](int x, int y) { return (x == 3 && y == 3) ? -1 : (x + y) % 2; },
+      [](int, int, int) { return 0.f; }, [](int c, int, int, int, int) { return c ? 3.f : 1.f; });
+  m.validate();
+  // Between texels (0,0) (cluster 0) and (1,0) (cluster 1), a quarter of the way.
+  const float x = (0.5f + 0.25f) / 4, y = 0.5f / 4;
+  EXPECT_NEAR(render::slf_radiance(m, {x, y}, Vector3d::UnitY()).x(), 0.75 * 1 + 0.25 * 3, 1e-6);
+  // Midway between (2,3) (cluster 1) and the unused (3,3): half of cluster 1's value.
+  EXPECT_NEAR(render::slf_radiance(m, {3.0f / 4, 3.5f / 4}, Vector3d::UnitY()).x(), 0.5 * 3, 1e-6);
+}
+
+// --- From the compression's output --------------------------------------------------------
+
+// A hand-made atlas of two triangles on a 4 x 3 map with unused texels between, a 4 x 4 grid
+// (order 4 SH layout: 16 directions, 3 channels, so dimension() = 3 Z W) and a random
+// compressed set: every owned texel's reconstruction at a grid direction is the set's own
+// reconstruction of its row there.
+TEST(SlfFromCompressed, RowsAreTheOwnedTexelsInOrder) {
+  meshes::Mesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  meshes::Atlas atlas;
+  atlas.width = 4;
+  atlas.height = 3;
+  atlas.uv = {{0.1f, 0.1f}, {0.4f, 0.1f}, {0.4f, 0.4f}, {0.6f, 0.6f}, {0.9f, 0.9f}, {0.6f, 0.9f}};
+  atlas.texel_triangle = {0, 0, -1, 1, 0, -1, 1, 1, -1, -1, 1, 1};
+  atlas.texel_barycentric.assign(12, Eigen::Vector2f::Zero());
+  const prt::SlfGrid grid{4, 4};
+  cpca::CompressedSet set;
+  set.order = 4;
+  set.channels = 3;
+  set.columns = 1;
+  set.vertex_count = 8;
+  set.cluster_count = 3;
+  set.component_count = 2;
+  ASSERT_EQ(set.dimension(), std::size_t(3 * grid.directions()));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> value(-1.f, 1.f);
+  set.cluster_of = {0, 1, 2, 2, 1, 0, 1, 2};
+  for (std::size_t i = 0; i < 8 * 2; ++i) set.weights.push_back(value(rng));
+  for (std::size_t i = 0; i < 3 * set.dimension(); ++i) set.means.push_back(value(rng));
+  for (std::size_t i = 0; i < 3 * 2 * set.dimension(); ++i) set.bases.push_back(value(rng));
+
+  const render::SlfModel m = render::slf_model_from_compressed(mesh, atlas, grid, set);
+  EXPECT_EQ(m.positions.size(), 6u);
+  EXPECT_EQ(m.uv, atlas.uv);
+  EXPECT_EQ(m.components, 2);
+  EXPECT_EQ(m.clusters, 3);
+  std::vector<float> row(set.dimension());
+  std::uint64_t r = 0;
+  for (int t = 0; t < 12; ++t) {
+    if (atlas.texel_triangle[std::size_t(t)] < 0) {
+      EXPECT_EQ(m.texel_cluster[std::size_t(t)], -1);
+      continue;
+    }
+    EXPECT_EQ(m.texel_cluster[std::size_t(t)], std::int32_t(set.cluster_of[r]));
+    cpca::reconstruct_vertex(set, r, row.data());
+    const Vector2f centre((t % 4 + 0.5f) / 4, (t / 4 + 0.5f) / 3);
+    for (int column = 0; column < grid.directions(); ++column) {
+      const Vector3f got = render::slf_radiance(m, centre, prt::slf_grid_direction(grid, column));
+      for (int ch = 0; ch < 3; ++ch)
+        EXPECT_NEAR(got[ch], row[std::size_t(column) * 3 + std::size_t(ch)], 1e-5)
+            << "texel " << t << " direction " << column;
+    }
+    ++r;
+  }
+  // One row too few for the atlas: refused, naming both counts.
+  cpca::CompressedSet short_set = set;
+  short_set.vertex_count = 7;
+  short_set.cluster_of.pop_back();
+  short_set.weights.resize(14);
+  try {
+    render::slf_model_from_compressed(mesh, atlas, grid, short_set);
+    ADD_FAILURE() << "accepted 7 rows for 8 owned texels";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("owns 8 texels"), std::string::npos) << e.what();
+  }
+  // A grid that does not match the rows' length.
+  EXPECT_THROW(render::slf_model_from_compressed(mesh, atlas, {8, 4}, set), std::invalid_argument);
+}
+
+// --- The GL image against the CPU reference ------------------------------------------------
+
+// Two quads, the nearer one partly covering the farther, with their own charts in one map;
+// clusters in blocks (fragments inside a block take the shared-cluster path, those on block
+// borders the four-cluster one), a few unused texels, k = 5 (a partly used weight layer),
+// view maps smooth in direction but different per cluster and slice, and no symmetry between
+// the columns on either side of the seam.
+render::SlfModel scene_model() {
+  render::SlfModel m;
+  add_quad(m, {-1.2f, -1.f, -0.4f}, {1.f, -1.2f, -0.5f}, {1.1f, 1.f, -0.3f}, {-1.f, 1.1f, -0.4f},
+           {0.f, 0.f}, {0.5f, 1.f});
+  add_quad(m, {-0.3f, -0.6f, 0.3f}, {0.9f, -0.5f, 0.2f}, {0.8f, 0.7f, 0.4f}, {-0.4f, 0.6f, 0.3f},
+           {0.5f, 0.f}, {1.f, 1.f});
+  m.map_width = 40;
+  m.map_height = 24;
+  m.grid = {10, 6};
+  m.components = 5;
+  m.clusters = 7;
+  const int k = m.components;
+  fill_maps(
+      m,
+      [](int x, int y) {
+        if (x >= 8 && x <= 9 && y >= 10 && y <= 11) return -1;
+        return (x / 7 + 2 * (y / 6)) % 7;
+      },
+      [](int x, int y, int j) {
+        return float(0.3 * std::sin(0.4 * x + 0.7 * j) + 0.2 * std::cos(0.5 * y - j));
+      },
+      [&](int c, int s, int i, int j, int ch) {
+        const double a = 2 * std::numbers::pi * (i + 0.5) / 10, p = (j + 0.5) / 6;
+        const double base = s == 0 ? 1.0 + 0.2 * c : 0.5 / (1 + s);
+        return float(base * (1.0 + 0.3 * std::sin(a + 0.5 * c + s + ch) + 0.4 * p * (ch + 1)) +
+                     0.05 * i * (s == k));
+      });
+  m.validate();
+  return m;
+}
+
+struct Comparison {
+  int coverage_differs = 0, value_differs = 0, covered = 0;
+  double worst = 0;  // relative to the largest radiance, over the pixels within tolerance
+};
+
+Comparison compare(const render::Image& gl, const render::Image& cpu, double tolerance) {
+  Comparison c;
+  double scale = 0;
+  for (std::size_t i = 0; i < cpu.rgba.size(); ++i)
+    if (i % 4 != 3) scale = std::max(scale, double(std::abs(cpu.rgba[i])));
+  std::vector<double> errors;
+  for (int y = 0; y < cpu.height; ++y)
+    for (int x = 0; x < cpu.width; ++x) {
+      const float* a = gl.pixel(x, y);
+      const float* b = cpu.pixel(x, y);
+      if (a[3] != b[3]) {
+        ++c.coverage_differs;
+        continue;
+      }
+      double e = 0;
+      for (int ch = 0; ch < 3; ++ch) e = std::max(e, double(std::abs(a[ch] - b[ch])) / scale);
+      if (b[3] == 1.f) ++c.covered;
+      if (e > tolerance)
+        ++c.value_differs;
+      else
+        c.worst = std::max(c.worst, e);
+    }
+  return c;
+}
+
+// GL's rasterisation and the ray cast may give a pixel whose centre lies within rounding of
+// an edge to different triangles (or none): a handful of pixels along the silhouettes and
+// the nearer quad's outline. Everywhere else the two agree to float rounding.
+constexpr double kImageTolerance = 1e-4;
+constexpr int kEdgePixels = 12;
+
+TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnBothPathsAndAtThePoles) {
+  render::GlContext ctx;
+  const render::SlfModel model = scene_model();
+  render::Camera front;  // looks down -Z: the view directions straddle the seam xi1 = 0
+  front.eye = {0.15, 0.1, 3.2};
+  front.target = {0, 0, 0};
+  front.width = 97;
+  front.height = 71;
+  front.near_plane = 0.5;
+  front.far_plane = 10;
+  // From high above and slightly in front: view directions near the +Y pole, where the
+  // polar rows clamp, and across the seam again.
+  render::Camera above = front;
+  above.eye = {0.05, 3.0, 0.9};
+  above.up = {0, 0, -1};
+  const render::SlfReferenceOptions reference_options{true, Vector3f(0.1f, 0.2f, 0.3f)};
+  render::Background background;
+  background.use_probe = false;
+  background.colour = render::Rgb(0.1f, 0.2f, 0.3f);
+  for (const render::Camera& camera : {front, above}) {
+    const render::Image cpu = render::render_slf_reference(model, camera, reference_options);
+    for (bool fast : {true, false}) {
+      render::GlDebugLog log;
+      render::SlfRenderer renderer(model, nullptr, {true, fast});
+      renderer.set_background(background);
+      renderer.render(camera);
+      const render::Image gl = renderer.read_image();
+      const Comparison c = compare(gl, cpu, kImageTolerance);
+      const std::string label = std::string(camera.eye.y() > 1 ? "above" : "front") +
+                                (fast ? ", shared-cluster path" : ", four texels everywhere");
+      EXPECT_GT(c.covered, camera.width * camera.height / 4) << label;
+      std::printf("DIAG %s covered %d cov %d val %d worst %g\n", label.c_str(), c.covered, c.coverage_differs, c.value_differs, c.worst);
+      EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels)
+          << label << " (worst of the others " << c.worst << ")";
+      EXPECT_TRUE(log.messages().empty()) << label << ": " << log.messages().front();
+      // Misses: the solid background, alpha 0.
+      EXPECT_FLOAT_EQ(gl.pixel(0, 0)[2], 0.3f) << label;
+      EXPECT_EQ(gl.pixel(0, 0)[3], 0.f) << label;
+    }
+  }
+}
+
+// Back faces are culled as the reference culls them: seen from behind, only the background.
+TEST(SlfRenderer, BackFacesAreCulledLikeTheReference) {
+  render::GlContext ctx;
+  const render::SlfModel model = scene_model();
+  render::Camera behind;
+  behind.eye = {0.1, 0.2, -3.0};
+  behind.width = 40;
+  behind.height = 30;
+  for (bool cull : {true, false}) {
+    render::SlfRenderer renderer(model, nullptr, {cull, true});
+    render::Background background;
+    background.use_probe = false;
+    renderer.set_background(background);
+    renderer.render(behind);
+    const render::Image cpu = render::render_slf_reference(model, behind, {cull, Vector3f::Zero()});
+    const Comparison c = compare(renderer.read_image(), cpu, kImageTolerance);
+    EXPECT_EQ(c.covered > 0, !cull);
+    EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels);
+  }
+}
+
+// The probe behind the mesh (alpha 0), unrotated; the mesh's pixels do not change with it.
+TEST(SlfRenderer, ProbeBackgroundFillsTheMisses) {
+  render::GlContext ctx;
+  const render::SlfModel model = scene_model();
+  const probes::Probe probe = probes::make_from_function(64, 32, [](const Vector3d& d) {
+    return probes::Rgb(float(1.0 + 0.5 * d.x()), float(1.0 + 0.5 * d.y()),
+                       float(1.0 - 0.5 * d.z()));
+  });
+  render::Camera camera;
+  camera.width = 48;
+  camera.height = 36;
+  camera.fov_y_degrees = 70;
+  render::SlfImageOptions with_probe;
+  const render::Image a = render::render_slf_image(model, camera, &probe, with_probe);
+  render::SlfImageOptions solid;
+  solid.background.use_probe = false;
+  const render::Image b = render::render_slf_image(model, camera, &probe, solid);
+  int misses = 0;
+  for (int y = 0; y < camera.height; ++y)
+    for (int x = 0; x < camera.width; ++x) {
+      const float* pa = a.pixel(x, y);
+      const float* pb = b.pixel(x, y);
+      ASSERT_EQ(pa[3], pb[3]);
+      if (pa[3] == 1.f) {
+        for (int ch = 0; ch < 3; ++ch) EXPECT_EQ(pa[ch], pb[ch]);
+        continue;
+      }
+      ++misses;
+      const probes::Rgb expected = probe.lookup(camera.pixel_direction(x, y));
+      for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(pa[ch], expected[ch], 0.03) << x << ", " << y;
+      EXPECT_EQ(pb[0], 0.f);
+    }
+  EXPECT_GT(misses, camera.width * camera.height / 4);
+}
+
+// Supersampling is the box filter of the larger frame, and the larger frame is the reference's.
+TEST(SlfRenderer, SupersampledImageIsTheFilteredLargeReference) {
+  render::GlContext ctx;
+  const render::SlfModel model = scene_model();
+  render::Camera camera;
+  camera.width = 30;
+  camera.height = 22;
+  render::SlfImageOptions o;
+  o.supersample = 2;
+  const render::Image gl = render::render_slf_image(model, camera, nullptr, o);
+  ASSERT_EQ(gl.width, 30);
+  const render::Image cpu = render::box_downsample(
+      render::render_slf_reference(model, render::supersampled(camera, 2)), 2);
+  // A pixel that one renderer covers at one more subsample than the other differs by a
+  // quarter of its radiance: few, on the outlines.
+  const Comparison c = compare(gl, cpu, kImageTolerance);
+  EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels);
+  EXPECT_THROW(render::render_slf_image(model, camera, nullptr, {{}, {}, 0}),
+               std::invalid_argument);
+}
+
+}  // namespace
