@@ -13,7 +13,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -404,7 +403,6 @@ TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnBothPathsAndAtThePoles) {
       const std::string label = std::string(camera.eye.y() > 1 ? "above" : "front") +
                                 (fast ? ", shared-cluster path" : ", four texels everywhere");
       EXPECT_GT(c.covered, camera.width * camera.height / 4) << label;
-      std::printf("DIAG %s covered %d cov %d val %d worst %g\n", label.c_str(), c.covered, c.coverage_differs, c.value_differs, c.worst);
       EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels)
           << label << " (worst of the others " << c.worst << ")";
       EXPECT_TRUE(log.messages().empty()) << label << ": " << log.messages().front();

@@ -86,10 +86,21 @@ std::string vertex_shader() {
 
 // Every size is a literal, and the sums over components are written out, so the compiler
 // sees constant layer indices (llvmpipe runs such code markedly faster than loops over
-// uniforms, render/shader_source.h). textureLod throughout: the fetches sit in non-uniform
-// control flow, where implicit derivatives are undefined, and there are no mipmaps.
-std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool fast_path) {
-  const int k = model.components;
+// uniforms, render/shader_source.h). textureLod throughout: the fetches sit in a loop with
+// a non-uniform trip count, where implicit derivatives are undefined, and there are no
+// mipmaps.
+//
+// The four texels are reconstructed cluster by cluster, in a loop over the distinct
+// clusters among them: an iteration takes the first texel not yet summed, gathers the
+// bilinear weights of every texel of its cluster, interpolates their weight vectors with
+// them and reads that cluster's k + 1 view-map slices once. Where the four share a cluster
+// (all but the fragments on cluster borders) one iteration does it all: k + 1 view fetches
+// instead of 4 (k + 1), the same sum by linearity. A loop rather than an if: llvmpipe runs
+// both sides of a branch for its whole SIMD group, but leaves a loop as soon as no lane of
+// the group needs another iteration, so the common case pays for one reconstruction only.
+// Without `shared`, each iteration takes one texel (four iterations where all are used).
+std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool shared) {
+  const int k = model.components, layers = (k + 3) / 4;
   std::string s = "#version 450 core\n";
   s += "in vec3 v_world;\nin vec2 v_uv;\n";
   s += "layout(location = 0) out vec4 o_colour;\n";
@@ -112,32 +123,6 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   s += "const vec2 kGridScale = vec2(" + float_literal(0.5 * model.grid.azimuth) + ", " +
        float_literal(model.grid.elevation) + ");\n";
   s += "const float kInvPi = " + float_literal(1.0 / 3.14159265358979323846) + ";\n";
-  s += "vec2 view_coord(int c, vec2 p) {\n"
-       "  return (vec2(c % kTileColumns, c / kTileColumns) * kTile + p) * kAtlasScale;\n"
-       "}\n";
-  // The k + 1 slices of cluster c at p, weighted by the weights in u0, u1, ...
-  auto sum = [&](const std::string& weights_prefix) {
-    std::string body = "  vec3 l = textureLod(u_views, vec3(q, 0.0), 0.0).rgb;\n";
-    for (int j = 0; j < k; ++j) {
-      body += "  l += " + weights_prefix + std::to_string(j / 4) + "." + "xyzw"[j % 4] +
-              " * textureLod(u_views, vec3(q, " + float_literal(1 + j) + "), 0.0).rgb;\n";
-    }
-    return body;
-  };
-  s += "vec3 texel_radiance(int c, ivec2 t, vec2 p) {\n  vec2 q = view_coord(c, p);\n";
-  for (int l = 0; l < (k + 3) / 4; ++l)
-    s += "  vec4 u" + std::to_string(l) + " = texelFetch(u_weights, ivec3(t, " + std::to_string(l) +
-         "), 0);\n";
-  s += sum("u");
-  s += "  return l;\n}\n";
-  if (fast_path) {
-    s += "vec3 shared_radiance(int c, vec2 p) {\n  vec2 q = view_coord(c, p);\n";
-    for (int l = 0; l < (k + 3) / 4; ++l)
-      s += "  vec4 u" + std::to_string(l) + " = textureLod(u_weights, vec3(v_uv, " +
-           float_literal(l) + "), 0.0);\n";
-    s += sum("u");
-    s += "  return l;\n}\n";
-  }
   s += "void main() {\n"
        "  vec3 d = normalize(u_eye - v_world);\n"
        // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
@@ -149,30 +134,45 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
        "  vec2 f = st - b;\n"
        "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
        "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
-       "  int c00 = texelFetch(u_cluster, lo, 0).r;\n"
-       "  int c10 = texelFetch(u_cluster, ivec2(hi.x, lo.y), 0).r;\n"
-       "  int c01 = texelFetch(u_cluster, ivec2(lo.x, hi.y), 0).r;\n"
-       "  int c11 = texelFetch(u_cluster, hi, 0).r;\n"
-       "  vec3 l = vec3(0.0);\n";
-  const char* general =
-      "    float w00 = (1.0 - f.x) * (1.0 - f.y), w10 = f.x * (1.0 - f.y);\n"
-      "    float w01 = (1.0 - f.x) * f.y, w11 = f.x * f.y;\n"
-      "    if (c00 >= 0 && w00 > 0.0) l += w00 * texel_radiance(c00, lo, p);\n"
-      "    if (c10 >= 0 && w10 > 0.0) l += w10 * texel_radiance(c10, ivec2(hi.x, lo.y), p);\n"
-      "    if (c01 >= 0 && w01 > 0.0) l += w01 * texel_radiance(c01, ivec2(lo.x, hi.y), p);\n"
-      "    if (c11 >= 0 && w11 > 0.0) l += w11 * texel_radiance(c11, hi, p);\n";
-  if (fast_path) {
-    s += "  if (c00 >= 0 && c00 == c10 && c00 == c01 && c00 == c11) {\n"
-         "    l = shared_radiance(c00, p);\n"
-         "  } else {\n";
-    s += general;
-    s += "  }\n";
+       // Texels (lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y) as x, y, z, w.
+       "  ivec4 c = ivec4(texelFetch(u_cluster, lo, 0).r,\n"
+       "                  texelFetch(u_cluster, ivec2(hi.x, lo.y), 0).r,\n"
+       "                  texelFetch(u_cluster, ivec2(lo.x, hi.y), 0).r,\n"
+       "                  texelFetch(u_cluster, hi, 0).r);\n"
+       "  vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * "
+       "f.y);\n"
+       // Texels left to sum: used (cluster >= 0) and of non-zero weight.
+       "  vec4 left = vec4(greaterThanEqual(c, ivec4(0))) * vec4(greaterThan(w, vec4(0.0)));\n";
+  const char* corner[4] = {"lo", "ivec2(hi.x, lo.y)", "ivec2(lo.x, hi.y)", "hi"};
+  for (int i = 0; i < 4; ++i)
+    for (int l = 0; l < layers; ++l)
+      s += "  vec4 u" + std::to_string(i) + "_" + std::to_string(l) +
+           " = texelFetch(u_weights, ivec3(" + corner[i] + ", " + std::to_string(l) + "), 0);\n";
+  s += "  vec3 l = vec3(0.0);\n"
+       "  do {\n"
+       "    int cl = left.x > 0.0 ? c.x : left.y > 0.0 ? c.y : left.z > 0.0 ? c.z : c.w;\n";
+  if (shared) {
+    s += "    vec4 take = left * vec4(equal(c, ivec4(cl)));\n";
   } else {
-    s += "  {\n";
-    s += general;
-    s += "  }\n";
+    s += "    vec4 take = left.x > 0.0 ? vec4(1, 0, 0, 0) : left.y > 0.0 ? vec4(0, 1, 0, 0)\n"
+         "              : left.z > 0.0 ? vec4(0, 0, 1, 0) : left;\n";
   }
-  s += "  o_colour = vec4(l, 1.0);\n}\n";
+  s += "    left -= take;\n"
+       "    vec4 m = take * w;\n"
+       "    int t = max(cl, 0);\n"
+       "    vec2 q = (vec2(t % kTileColumns, t / kTileColumns) * kTile + p) * kAtlasScale;\n"
+       "    l += (m.x + m.y + m.z + m.w) * textureLod(u_views, vec3(q, 0.0), 0.0).rgb;\n";
+  for (int l = 0; l < layers; ++l) {
+    const std::string n = std::to_string(l);
+    s += "    vec4 u" + n + " = m.x * u0_" + n + " + m.y * u1_" + n + " + m.z * u2_" + n +
+         " + m.w * u3_" + n + ";\n";
+  }
+  for (int j = 0; j < k; ++j)
+    s += "    l += u" + std::to_string(j / 4) + "." + "xyzw"[j % 4] +
+         " * textureLod(u_views, vec3(q, " + float_literal(1 + j) + "), 0.0).rgb;\n";
+  s += "  } while (any(greaterThan(left, vec4(0.0))));\n"
+       "  o_colour = vec4(l, 1.0);\n"
+       "}\n";
   return s;
 }
 
