@@ -135,10 +135,7 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
        "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
        "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
        // Texels (lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y) as x, y, z, w.
-       "  ivec4 c = ivec4(texelFetch(u_cluster, lo, 0).r,\n"
-       "                  texelFetch(u_cluster, ivec2(hi.x, lo.y), 0).r,\n"
-       "                  texelFetch(u_cluster, ivec2(lo.x, hi.y), 0).r,\n"
-       "                  texelFetch(u_cluster, hi, 0).r);\n"
+       "  ivec4 c = textureGather(u_cluster, (b + 1.0) / kMap).wzxy;\n"
        "  vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * "
        "f.y);\n"
        // Texels left to sum: used (cluster >= 0) and of non-zero weight.
