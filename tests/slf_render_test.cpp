@@ -372,7 +372,7 @@ Comparison compare(const render::Image& gl, const render::Image& cpu, double tol
 constexpr double kImageTolerance = 1e-4;
 constexpr int kEdgePixels = 12;
 
-TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnBothPathsAndAtThePoles) {
+TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnEveryPathAndAtThePoles) {
   render::GlContext ctx;
   const render::SlfModel model = scene_model();
   render::Camera front;  // looks down -Z: the view directions straddle the seam xi1 = 0
@@ -393,15 +393,17 @@ TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnBothPathsAndAtThePoles) {
   background.colour = render::Rgb(0.1f, 0.2f, 0.3f);
   for (const render::Camera& camera : {front, above}) {
     const render::Image cpu = render::render_slf_reference(model, camera, reference_options);
-    for (bool fast : {true, false}) {
+    for (int variant = 0; variant < 4; ++variant) {
+      const bool fast = variant % 2 == 0, deferred = variant >= 2;
       render::GlDebugLog log;
-      render::SlfRenderer renderer(model, nullptr, {true, fast});
+      render::SlfRenderer renderer(model, nullptr, {true, fast, deferred});
       renderer.set_background(background);
       renderer.render(camera);
       const render::Image gl = renderer.read_image();
       const Comparison c = compare(gl, cpu, kImageTolerance);
       const std::string label = std::string(camera.eye.y() > 1 ? "above" : "front") +
-                                (fast ? ", shared-cluster path" : ", four texels everywhere");
+                                (fast ? ", shared-cluster path" : ", four texels everywhere") +
+                                (deferred ? ", deferred" : ", one pass");
       EXPECT_GT(c.covered, camera.width * camera.height / 4) << label;
       EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels)
           << label << " (worst of the others " << c.worst << ")";
@@ -421,8 +423,9 @@ TEST(SlfRenderer, BackFacesAreCulledLikeTheReference) {
   behind.eye = {0.1, 0.2, -3.0};
   behind.width = 40;
   behind.height = 30;
-  for (bool cull : {true, false}) {
-    render::SlfRenderer renderer(model, nullptr, {cull, true});
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool cull = variant % 2 == 0, deferred = variant >= 2;
+    render::SlfRenderer renderer(model, nullptr, {cull, true, deferred});
     render::Background background;
     background.use_probe = false;
     renderer.set_background(background);

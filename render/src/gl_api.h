@@ -56,6 +56,7 @@
   X(glDisableVertexAttribArray)  \
   X(glDispatchCompute)           \
   X(glDrawArrays)                \
+  X(glDrawBuffers)               \
   X(glDrawElements)              \
   X(glEnable)                    \
   X(glEnableVertexAttribArray)   \
@@ -64,6 +65,7 @@
   X(glFinish)                    \
   X(glFlush)                     \
   X(glFramebufferRenderbuffer)   \
+  X(glFramebufferTexture2D)      \
   X(glFrontFace)                 \
   X(glGenBuffers)                \
   X(glGenFramebuffers)           \
@@ -95,6 +97,7 @@
   X(glTransformFeedbackVaryings) \
   X(glUniform1i)                 \
   X(glUniform1ui)                \
+  X(glUniform2f)                 \
   X(glUniform3f)                 \
   X(glUniform3fv)                \
   X(glUniformMatrix3fv)          \
@@ -166,6 +169,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glDisableVertexAttribArray (::render::gl::current->glDisableVertexAttribArray)
 #define glDispatchCompute (::render::gl::current->glDispatchCompute)
 #define glDrawArrays (::render::gl::current->glDrawArrays)
+#define glDrawBuffers (::render::gl::current->glDrawBuffers)
 #define glDrawElements (::render::gl::current->glDrawElements)
 #define glEnable (::render::gl::current->glEnable)
 #define glEnableVertexAttribArray (::render::gl::current->glEnableVertexAttribArray)
@@ -174,6 +178,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glFinish (::render::gl::current->glFinish)
 #define glFlush (::render::gl::current->glFlush)
 #define glFramebufferRenderbuffer (::render::gl::current->glFramebufferRenderbuffer)
+#define glFramebufferTexture2D (::render::gl::current->glFramebufferTexture2D)
 #define glFrontFace (::render::gl::current->glFrontFace)
 #define glGenBuffers (::render::gl::current->glGenBuffers)
 #define glGenFramebuffers (::render::gl::current->glGenFramebuffers)
@@ -205,6 +210,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glTransformFeedbackVaryings (::render::gl::current->glTransformFeedbackVaryings)
 #define glUniform1i (::render::gl::current->glUniform1i)
 #define glUniform1ui (::render::gl::current->glUniform1ui)
+#define glUniform2f (::render::gl::current->glUniform2f)
 #define glUniform3f (::render::gl::current->glUniform3f)
 #define glUniform3fv (::render::gl::current->glUniform3fv)
 #define glUniformMatrix3fv (::render::gl::current->glUniformMatrix3fv)

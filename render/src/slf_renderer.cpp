@@ -19,7 +19,7 @@ namespace render {
 namespace slf_gl {
 
 // Texture units, fixed in the shader's layout(binding) qualifiers.
-constexpr int kClusterUnit = 0, kViewsUnit = 1, kWeightsUnit = 2;
+constexpr int kClusterUnit = 0, kViewsUnit = 1, kWeightsUnit = 2, kUvUnit = 3;
 
 // How the clusters' view maps tile one layer of the view-map array.
 struct TileLayout {
@@ -84,6 +84,24 @@ std::string vertex_shader() {
          "}\n";
 }
 
+// The deferred path's pre-pass: the atlas coordinate into colour attachment 1.
+std::string uv_fragment_shader() {
+  return "#version 450 core\n"
+         "in vec3 v_world;\nin vec2 v_uv;\n"
+         "layout(location = 1) out vec4 o_uv;\n"
+         "void main() { o_uv = vec4(v_uv, 0.0, 1.0); }\n";
+}
+
+// The deferred path's shading pass: one triangle over the screen at the far plane, drawn
+// with GL_GREATER so that only the pixels the pre-pass covered are shaded.
+std::string fullscreen_vertex_shader() {
+  return "#version 450 core\n"
+         "void main() {\n"
+         "  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
+         "  gl_Position = vec4(p, 1.0, 1.0);\n"
+         "}\n";
+}
+
 // Every size is a literal, and the sums over components are written out, so the compiler
 // sees constant layer indices (llvmpipe runs such code markedly faster than loops over
 // uniforms, render/shader_source.h). textureLod throughout: the fetches sit in a loop with
@@ -99,12 +117,19 @@ std::string vertex_shader() {
 // both sides of a branch for its whole SIMD group, but leaves a loop as soon as no lane of
 // the group needs another iteration, so the common case pays for one reconstruction only.
 // Without `shared`, each iteration takes one texel (four iterations where all are used).
-std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool shared) {
+// Deferred: the atlas coordinate comes from the uv pre-pass's texture and the direction from
+// the pixel's ray (the CPU reference's Camera::pixel_direction, reversed).
+std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool shared,
+                            bool deferred) {
   const int k = model.components, layers = (k + 3) / 4;
   std::string s = "#version 450 core\n";
-  s += "in vec3 v_world;\nin vec2 v_uv;\n";
   s += "layout(location = 0) out vec4 o_colour;\n";
-  s += "uniform vec3 u_eye;\n";
+  if (deferred) {
+    s += "layout(binding = " + std::to_string(kUvUnit) + ") uniform sampler2D u_uv;\n";
+    s += "uniform vec3 u_forward, u_right, u_up;\nuniform vec2 u_pixel_scale;\n";
+  } else {
+    s += "in vec3 v_world;\nin vec2 v_uv;\nuniform vec3 u_eye;\n";
+  }
   s += "layout(binding = " + std::to_string(kClusterUnit) + ") uniform isampler2D u_cluster;\n";
   s += "layout(binding = " + std::to_string(kViewsUnit) + ") uniform sampler2DArray u_views;\n";
   if (k > 0)
@@ -123,23 +148,29 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   s += "const vec2 kGridScale = vec2(" + float_literal(0.5 * model.grid.azimuth) + ", " +
        float_literal(model.grid.elevation) + ");\n";
   s += "const float kInvPi = " + float_literal(1.0 / 3.14159265358979323846) + ";\n";
-  s += "void main() {\n"
-       "  vec3 d = normalize(u_eye - v_world);\n"
-       // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
-       "  float azimuth = (d.x == 0.0 && d.z == 0.0) ? 0.0 : atan(d.x, -d.z);\n"
-       "  vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(d.y, -1.0, 1.0)) * kInvPi);\n"
-       "  vec2 p = vec2(1.0) + xi * kGridScale;\n"
-       "  vec2 st = v_uv * kMap - 0.5;\n"
-       "  vec2 b = floor(st);\n"
-       "  vec2 f = st - b;\n"
-       "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
-       "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
-       // Texels (lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y) as x, y, z, w.
-       "  ivec4 c = textureGather(u_cluster, (b + 1.0) / kMap).wzxy;\n"
-       "  vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * "
-       "f.y);\n"
-       // Texels left to sum: used (cluster >= 0) and of non-zero weight.
-       "  vec4 left = vec4(greaterThanEqual(c, ivec4(0))) * vec4(greaterThan(w, vec4(0.0)));\n";
+  s += "void main() {\n";
+  if (deferred)
+    s += "  vec2 v_uv = texelFetch(u_uv, ivec2(gl_FragCoord.xy), 0).xy;\n"
+         "  vec2 ndc = gl_FragCoord.xy * u_pixel_scale - 1.0;\n"
+         "  vec3 d = -normalize(u_forward + ndc.x * u_right + ndc.y * u_up);\n";
+  else
+    s += "  vec3 d = normalize(u_eye - v_world);\n";
+  s +=
+      // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
+      "  float azimuth = (d.x == 0.0 && d.z == 0.0) ? 0.0 : atan(d.x, -d.z);\n"
+      "  vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(d.y, -1.0, 1.0)) * kInvPi);\n"
+      "  vec2 p = vec2(1.0) + xi * kGridScale;\n"
+      "  vec2 st = v_uv * kMap - 0.5;\n"
+      "  vec2 b = floor(st);\n"
+      "  vec2 f = st - b;\n"
+      "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
+      "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
+      // Texels (lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y) as x, y, z, w.
+      "  ivec4 c = textureGather(u_cluster, (b + 1.0) / kMap).wzxy;\n"
+      "  vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * "
+      "f.y);\n"
+      // Texels left to sum: used (cluster >= 0) and of non-zero weight.
+      "  vec4 left = vec4(greaterThanEqual(c, ivec4(0))) * vec4(greaterThan(w, vec4(0.0)));\n";
   const char* corner[4] = {"lo", "ivec2(hi.x, lo.y)", "ivec2(lo.x, hi.y)", "hi"};
   for (int i = 0; i < 4; ++i)
     for (int l = 0; l < layers; ++l)
@@ -189,13 +220,17 @@ struct SlfRenderer::Impl {
   ~Impl();
   void build_program();
   void draw(const Camera& camera);
+  void draw_deferred(const Camera& camera);
+  void bind_textures();
 
   SlfRendererOptions options;
   SlfModel shape;  // sizes only (the arrays are uploaded and dropped)
   slf_gl::TileLayout tiles;
   GLuint vao = 0, vbo = 0, cluster_texture = 0, views_texture = 0, weights_texture = 0;
+  GLuint uv_texture = 0;  // deferred: the pre-pass's atlas coordinates, at the frame's size
+  int uv_width = 0, uv_height = 0;
   GLsizei vertex_count = 0;
-  GlProgram program;
+  GlProgram program, uv_program;
   BackgroundPass background_pass;
   Background background;
   FrameTarget target;
@@ -311,8 +346,17 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
 }
 
 void SlfRenderer::Impl::build_program() {
-  program = GlProgram("surface light field", slf_gl::vertex_shader(),
-                      slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path));
+  if (options.deferred) {
+    program =
+        GlProgram("surface light field (deferred shading)", slf_gl::fullscreen_vertex_shader(),
+                  slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path, true));
+    uv_program = GlProgram("surface light field (uv pre-pass)", slf_gl::vertex_shader(),
+                           slf_gl::uv_fragment_shader());
+  } else {
+    program =
+        GlProgram("surface light field", slf_gl::vertex_shader(),
+                  slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path, false));
+  }
 }
 
 SlfRenderer::Impl::~Impl() {
@@ -321,6 +365,71 @@ SlfRenderer::Impl::~Impl() {
   glDeleteTextures(1, &cluster_texture);
   glDeleteTextures(1, &views_texture);
   if (weights_texture) glDeleteTextures(1, &weights_texture);
+  if (uv_texture) glDeleteTextures(1, &uv_texture);
+}
+
+void SlfRenderer::Impl::bind_textures() {
+  glActiveTexture(GL_TEXTURE0 + slf_gl::kClusterUnit);
+  glBindTexture(GL_TEXTURE_2D, cluster_texture);
+  glActiveTexture(GL_TEXTURE0 + slf_gl::kViewsUnit);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, views_texture);
+  if (weights_texture) {
+    glActiveTexture(GL_TEXTURE0 + slf_gl::kWeightsUnit);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, weights_texture);
+  }
+  glActiveTexture(GL_TEXTURE0);
+}
+
+// The mesh once with a trivial shader writing its atlas coordinates (and depth), then one
+// screen-sized triangle shading the covered pixels. The uv texture is attached to the frame
+// target's framebuffer only while the pre-pass writes it, so the shading pass samples a
+// texture that no attachment of the bound framebuffer holds (no feedback loop).
+void SlfRenderer::Impl::draw_deferred(const Camera& camera) {
+  if (!uv_texture || uv_width != camera.width || uv_height != camera.height) {
+    if (!uv_texture) glGenTextures(1, &uv_texture);
+    glBindTexture(GL_TEXTURE_2D, uv_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RG32F, camera.width, camera.height, 0, GL_RG, GL_FLOAT,
+                 nullptr);
+    slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
+    uv_width = camera.width;
+    uv_height = camera.height;
+  }
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, uv_texture, 0);
+  const GLenum uv_only[2] = {GL_NONE, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, uv_only);
+  uv_program.use();
+  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
+  glUniformMatrix4fv(uv_program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
+  glBindVertexArray(vao);
+  glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+  const GLenum colour_only[1] = {GL_COLOR_ATTACHMENT0};
+  glDrawBuffers(1, colour_only);
+
+  glDisable(GL_CULL_FACE);
+  glDepthFunc(GL_GREATER);
+  glDepthMask(GL_FALSE);
+  program.use();
+  // The pixel's ray as Camera::pixel_direction forms it: forward + ndc_x t a right + ndc_y t up.
+  const Eigen::Vector3d f = (camera.target - camera.eye).normalized();
+  const Eigen::Vector3d r = f.cross(camera.up).normalized();
+  const Eigen::Vector3d u = r.cross(f);
+  const double t = std::tan(0.5 * camera.fov_y_degrees * 3.14159265358979323846 / 180.0);
+  const Eigen::Vector3f ff = f.cast<float>(), rr = (r * t * camera.aspect()).cast<float>(),
+                        uu = (u * t).cast<float>();
+  glUniform3f(program.uniform("u_forward"), ff.x(), ff.y(), ff.z());
+  glUniform3f(program.uniform("u_right"), rr.x(), rr.y(), rr.z());
+  glUniform3f(program.uniform("u_up"), uu.x(), uu.y(), uu.z());
+  glUniform2f(program.uniform("u_pixel_scale"), float(2.0 / camera.width),
+              float(2.0 / camera.height));
+  bind_textures();
+  glActiveTexture(GL_TEXTURE0 + slf_gl::kUvUnit);
+  glBindTexture(GL_TEXTURE_2D, uv_texture);
+  glActiveTexture(GL_TEXTURE0);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glBindVertexArray(0);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
 }
 
 void SlfRenderer::Impl::draw(const Camera& camera) {
@@ -347,23 +456,19 @@ void SlfRenderer::Impl::draw(const Camera& camera) {
   } else {
     glDisable(GL_CULL_FACE);
   }
-  program.use();
-  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
-  glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
-  const Eigen::Vector3f eye = camera.eye.cast<float>();
-  glUniform3f(program.uniform("u_eye"), eye.x(), eye.y(), eye.z());
-  glActiveTexture(GL_TEXTURE0 + slf_gl::kClusterUnit);
-  glBindTexture(GL_TEXTURE_2D, cluster_texture);
-  glActiveTexture(GL_TEXTURE0 + slf_gl::kViewsUnit);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, views_texture);
-  if (weights_texture) {
-    glActiveTexture(GL_TEXTURE0 + slf_gl::kWeightsUnit);
-    glBindTexture(GL_TEXTURE_2D_ARRAY, weights_texture);
+  if (options.deferred) {
+    draw_deferred(camera);
+  } else {
+    program.use();
+    const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
+    glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
+    const Eigen::Vector3f eye = camera.eye.cast<float>();
+    glUniform3f(program.uniform("u_eye"), eye.x(), eye.y(), eye.z());
+    bind_textures();
+    glBindVertexArray(vao);
+    glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+    glBindVertexArray(0);
   }
-  glActiveTexture(GL_TEXTURE0);
-  glBindVertexArray(vao);
-  glDrawArrays(GL_TRIANGLES, 0, vertex_count);
-  glBindVertexArray(0);
   glDisable(GL_CULL_FACE);
 }
 
@@ -382,7 +487,9 @@ void SlfRenderer::set_probe(const probes::Probe* probe) {
 }
 
 void SlfRenderer::set_options(const SlfRendererOptions& options) {
-  const bool rebuild = options.shared_cluster_fast_path != impl_->options.shared_cluster_fast_path;
+  const bool rebuild =
+      options.shared_cluster_fast_path != impl_->options.shared_cluster_fast_path ||
+      options.deferred != impl_->options.deferred;
   impl_->options = options;
   if (rebuild) impl_->build_program();
 }

@@ -36,6 +36,8 @@ struct SlfRendererOptions {
   // Interpolate the weights first where the four texels share a cluster (see above); false
   // reconstructs all four texels everywhere, to measure the difference.
   bool shared_cluster_fast_path = true;
+  // Shade after a uv pre-pass instead of in the mesh's own pass (see above).
+  bool deferred = false;
 };
 
 class SlfRenderer {
