@@ -29,6 +29,12 @@ struct TileLayout {
   int height() const { return rows * tile_height; }
 };
 
+// Layers of the view-map array: the k + 1 slices' 3 (k + 1) floats of a direction packed
+// four a texel (RGB alone would leave a quarter of every fetch unused).
+int view_layers(int components) {
+  return (3 * (components + 1) + 3) / 4;
+}
+
 int gl_integer(GLenum name) {
   GLint value = 0;
   glGetIntegerv(name, &value);
@@ -189,15 +195,31 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
        "    vec4 m = take * w;\n"
        "    int t = max(cl, 0);\n"
        "    vec2 q = (vec2(t % kTileColumns, t / kTileColumns) * kTile + p) * kAtlasScale;\n"
-       "    l += (m.x + m.y + m.z + m.w) * textureLod(u_views, vec3(q, 0.0), 0.0).rgb;\n";
+       "    float a0 = m.x + m.y + m.z + m.w;\n";
   for (int l = 0; l < layers; ++l) {
     const std::string n = std::to_string(l);
     s += "    vec4 u" + n + " = m.x * u0_" + n + " + m.y * u1_" + n + " + m.z * u2_" + n +
          " + m.w * u3_" + n + ";\n";
   }
-  for (int j = 0; j < k; ++j)
-    s += "    l += u" + std::to_string(j / 4) + "." + "xyzw"[j % 4] +
-         " * textureLod(u_views, vec3(q, " + float_literal(1 + j) + "), 0.0).rgb;\n";
+  // The k + 1 slices' RGB values, packed four floats a texel (view_layers); slice 0's
+  // coefficient is the weights' sum, slice 1 + j's the interpolated weight j.
+  const int view_layers = slf_gl::view_layers(k);
+  for (int v = 0; v < view_layers; ++v)
+    s += "    vec4 t" + std::to_string(v) + " = textureLod(u_views, vec3(q, " + float_literal(v) +
+         "), 0.0);\n";
+  for (int f = 0; f < 3 * (k + 1); ++f) {
+    const int slice = f / 3, channel = f % 3;
+    std::string coefficient = "a0";
+    if (slice > 0) {
+      coefficient = "u";  // appended: GCC 12's -Wstringop-overflow misfires on "u" + string
+      coefficient += std::to_string((slice - 1) / 4);
+      coefficient += '.';
+      coefficient += "xyzw"[(slice - 1) % 4];
+    }
+    s += "    l.";
+    s += "xyz"[channel];
+    s += " += " + coefficient + " * t" + std::to_string(f / 4) + "." + "xyzw"[f % 4] + ";\n";
+  }
   s += "  } while (any(greaterThan(left, vec4(0.0))));\n"
        "  o_colour = vec4(l, 1.0);\n"
        "}\n";
@@ -305,13 +327,16 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
     slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_LINEAR);
   }
 
-  // View maps: layer s holds slice s of every cluster, cluster c's tile at
-  // (c % columns, c / columns); inside a tile, texel (1 + i, 1 + j) is direction (i, j), the
-  // columns 0 and Z + 1 repeat directions Z - 1 and 0 (the azimuth wraps around) and the rows
-  // 0 and W + 1 repeat rows 0 and W - 1 (the poles clamp).
+  // View maps: float f = 3 s + channel of slice s (0 the mean, 1 + j component j) in
+  // component f % 4 of layer f / 4, so that a direction's 3 (k + 1) floats take
+  // ceil(3 (k + 1) / 4) fetches. Cluster c's tile sits at (c % columns, c / columns); inside
+  // a tile, texel (1 + i, 1 + j) is direction (i, j), the columns 0 and Z + 1 repeat
+  // directions Z - 1 and 0 (the azimuth wraps around) and the rows 0 and W + 1 repeat rows 0
+  // and W - 1 (the poles clamp).
   const int z = model.grid.azimuth, w = model.grid.elevation;
+  const int view_layers = slf_gl::view_layers(k);
   const std::size_t layer_texels = std::size_t(tiles.width()) * std::size_t(tiles.height());
-  std::vector<float> views(layer_texels * 4 * std::size_t(k + 1), 0.f);
+  std::vector<float> views(layer_texels * 4 * std::size_t(view_layers), 0.f);
   for (int slice = 0; slice <= k; ++slice)
     for (int c = 0; c < model.clusters; ++c) {
       const float* v = model.view_slice(c, slice);
@@ -322,21 +347,19 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
         for (int tx = 0; tx < tiles.tile_width; ++tx) {
           const int i = (tx - 1 + z) % z;
           const float* rgb = v + (std::size_t(j) * std::size_t(z) + std::size_t(i)) * 3;
-          float* out = views.data() +
-                       (std::size_t(slice) * layer_texels +
-                        std::size_t(y0 + ty) * std::size_t(tiles.width()) + std::size_t(x0 + tx)) *
-                           4;
-          out[0] = rgb[0];
-          out[1] = rgb[1];
-          out[2] = rgb[2];
-          out[3] = 1.f;
+          const std::size_t texel =
+              std::size_t(y0 + ty) * std::size_t(tiles.width()) + std::size_t(x0 + tx);
+          for (int channel = 0; channel < 3; ++channel) {
+            const std::size_t f = std::size_t(3 * slice + channel);
+            views[((f / 4) * layer_texels + texel) * 4 + f % 4] = rgb[channel];
+          }
         }
       }
     }
   glGenTextures(1, &views_texture);
   glBindTexture(GL_TEXTURE_2D_ARRAY, views_texture);
-  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, tiles.width(), tiles.height(), k + 1, 0, GL_RGBA,
-               GL_FLOAT, views.data());
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, tiles.width(), tiles.height(), view_layers, 0,
+               GL_RGBA, GL_FLOAT, views.data());
   slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_LINEAR);
   check_gl("SlfRenderer: textures");
 
