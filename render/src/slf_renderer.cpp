@@ -324,7 +324,7 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
     glBindTexture(GL_TEXTURE_2D_ARRAY, weights_texture);
     glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA32F, x_size, y_size, layers, 0, GL_RGBA, GL_FLOAT,
                  weights.data());
-    slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_LINEAR);
+    slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_NEAREST);  // texelFetch only
   }
 
   // View maps: float f = 3 s + channel of slice s (0 the mean, 1 + j component j) in

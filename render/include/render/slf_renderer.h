@@ -5,16 +5,29 @@
 // (tests hold the two to float rounding). No super-clusters: a fragment can read any cluster,
 // so every triangle is drawn once.
 //
-// Textures: the cluster id per texel (R32I, fetched); the surface map's weights (RGBA32F
-// array, four components a layer); the view maps as one RGBA32F array with a layer per slice
-// (0 the mean, 1 + j component j) whose layers tile the clusters' Z x W maps, each tile with
-// a one-texel gutter (azimuth wrapped around, poles clamped) so that the hardware's bilinear
-// filter interpolates direction, seam included, in one fetch per texel and slice. A tile's
-// corner follows from the cluster id by arithmetic (a division by the tiles per row), which
-// costs less than the dependent fetch of the paper's cluster-map texture. Where the four
-// texels share a cluster (all but the fragments along cluster borders), the weights are
-// interpolated first (filtered fetches of the surface map) and the cluster's k + 1 slices
-// are read once: k + 1 view fetches instead of 4 (k + 1), the same sum by linearity.
+// Textures: the cluster id per texel (R32I, the four around a fragment in one gather); the
+// surface map's weights (RGBA32F array, four components a layer); the view maps as one
+// RGBA32F array whose layers tile the clusters' Z x W maps, each tile with a one-texel gutter
+// (azimuth wrapped around, poles clamped) so that the hardware's bilinear filter interpolates
+// direction, seam included, in one fetch per texel; a direction's 3 (k + 1) floats (slice 0
+// the mean, 1 + j component j, RGB each) are packed four a texel across the layers, so a
+// cluster costs ceil(3 (k + 1) / 4) view fetches (7 at k = 8). A tile's corner follows from
+// the cluster id by arithmetic (a division by the tiles per row), which costs less than the
+// dependent fetch of the paper's cluster-map texture.
+//
+// The four texels are summed cluster by cluster: the fragment loops over the distinct
+// clusters among them, interpolating the weights of each cluster's texels first and reading
+// its view maps once; where the four share a cluster (all but the fragments on cluster
+// borders) that is one iteration, the view fetches of one texel instead of four, the same
+// sum by linearity. A loop, not an if: llvmpipe runs both sides of a branch for its whole
+// SIMD group, but leaves a loop once no lane needs another iteration.
+//
+// Deferred option: the mesh is first drawn with a trivial shader writing its atlas
+// coordinates (and depth), then one screen-sized triangle, depth-tested against it, shades
+// the covered pixels, the direction from the pixel's ray. The same reconstruction, but
+// llvmpipe shades in 4 x 4 blocks, so a mesh of 5-pixel triangles (the bunny at 1280 x 948)
+// costs the one-pass shader several blocks a triangle; shading once per covered pixel halves
+// the frame there (bench/slf_bench.cpp).
 //
 // Precision: on Mesa's rasterisers the filter weights are single floats; a hardware GPU's
 // texture units may quantise them (8 fractional bits on many), which rounds the
@@ -33,8 +46,8 @@ namespace render {
 
 struct SlfRendererOptions {
   bool cull_back_faces = true;  // closed meshes; the SLF of a face seen from behind is not stored
-  // Interpolate the weights first where the four texels share a cluster (see above); false
-  // reconstructs all four texels everywhere, to measure the difference.
+  // Sum the texels cluster by cluster (see above); false reconstructs each of the four
+  // texels on its own, to measure the difference.
   bool shared_cluster_fast_path = true;
   // Shade after a uv pre-pass instead of in the mesh's own pass (see above).
   bool deferred = false;
