@@ -60,6 +60,49 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
       number_in(0, 0.01));
 }
 
+void add_material_flags(CLI::App* cmd, MaterialFlags& f) {
+  f.command = cmd;
+  add_checked_option(cmd, "--material", f.material, "Reflectance model",
+                     CLI::IsMember({"lambert", "phong", "cook-torrance"}));
+  cmd->add_option("--albedo", f.albedo, "Diffuse albedo: one value (grey) or R,G,B")
+      ->capture_default_str();
+  add_checked_option(cmd, "--specular", f.values.specular,
+                     "Specular reflectance (phong, cook-torrance)", number_in(0, 1));
+  add_checked_option(cmd, "--exponent", f.values.exponent, "Phong exponent", number_in(0, 10000));
+  add_checked_option(cmd, "--roughness", f.values.roughness, "Cook-Torrance Beckmann roughness",
+                     number_in(0, 1));
+  add_checked_option(cmd, "--f0", f.values.f0,
+                     "Cook-Torrance Fresnel reflectance at normal incidence", number_in(0, 1));
+  add_checked_option(
+      cmd, "--masking", f.masking,
+      "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the thesis's)",
+      CLI::IsMember({"smith", "v-groove"}));
+}
+
+prt::Material resolve_material_flags(const MaterialFlags& f) {
+  prt::Material m = f.values;
+  m.kind = prt::kMaterialNames.parse(f.material);
+  m.albedo = parse_albedo(f.albedo);
+  m.masking = prt::kMaskingNames.parse(f.masking);
+  auto unused = [&](const char* flag, bool used) {
+    if (f.command && f.command->count(flag) && !used) {
+      throw UsageError(std::string(flag) + " does not apply to --material " + f.material);
+    }
+  };
+  unused("--exponent", m.kind == prt::MaterialKind::kPhong);
+  unused("--roughness", m.kind == prt::MaterialKind::kCookTorrance);
+  unused("--f0", m.kind == prt::MaterialKind::kCookTorrance);
+  unused("--masking", m.kind == prt::MaterialKind::kCookTorrance);
+  unused("--specular", m.kind != prt::MaterialKind::kLambert);
+  if (m.kind == prt::MaterialKind::kLambert) m.specular = 0.f;
+  try {
+    m.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return m;
+}
+
 prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
   prt::BakeOptions bake = f.bake;
   bake.kind = f.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;

@@ -24,4 +24,17 @@ void add_bake_flags(CLI::App* command, BakeFlags& flags);
 // a material parameter the chosen material never reads).
 prt::BakeOptions resolve_bake_flags(const BakeFlags& flags);
 
+// The material flags alone (--material, --albedo, --specular, --exponent, --roughness, --f0,
+// --masking) with the same help and checks, for commands that shade without an SH bake
+// (prtr slf, prtr path-trace).
+struct MaterialFlags {
+  std::string material = "phong", albedo = "0.5", masking = "smith";
+  prt::Material values;
+  CLI::App* command = nullptr;
+};
+void add_material_flags(CLI::App* command, MaterialFlags& flags);
+// The material, validated; UsageError naming the flag otherwise (also for a parameter the
+// chosen material never reads).
+prt::Material resolve_material_flags(const MaterialFlags& flags);
+
 }  // namespace prtr_app
