@@ -11,22 +11,9 @@
 
 namespace prtr_app {
 
-struct BakeFlags {
-  std::string kind = "glossy", material = "phong", albedo = "0.5";
-  std::string masking = "smith", view_fit = "least-squares";
-  prt::BakeOptions bake;
-  CLI::App* command = nullptr;  // to tell which flags were given
-};
-
-void add_bake_flags(CLI::App* command, BakeFlags& flags);
-
-// The options the flags describe, validated; UsageError naming the flag otherwise (also for
-// a material parameter the chosen material never reads).
-prt::BakeOptions resolve_bake_flags(const BakeFlags& flags);
-
-// The material flags alone (--material, --albedo, --specular, --exponent, --roughness, --f0,
-// --masking) with the same help and checks, for commands that shade without an SH bake
-// (prtr slf, prtr path-trace).
+// The material flags (--material, --albedo, --specular, --exponent, --roughness, --f0,
+// --masking): part of the bake flags, and alone for the commands that shade without an SH
+// bake (prtr slf, prtr path-trace).
 struct MaterialFlags {
   std::string material = "phong", albedo = "0.5", masking = "smith";
   prt::Material values;
@@ -36,5 +23,18 @@ void add_material_flags(CLI::App* command, MaterialFlags& flags);
 // The material, validated; UsageError naming the flag otherwise (also for a parameter the
 // chosen material never reads).
 prt::Material resolve_material_flags(const MaterialFlags& flags);
+
+struct BakeFlags {
+  std::string kind = "glossy", view_fit = "least-squares";
+  MaterialFlags material;  // --material and its parameters, resolved into bake.material
+  prt::BakeOptions bake;
+  CLI::App* command = nullptr;  // to tell which flags were given
+};
+
+void add_bake_flags(CLI::App* command, BakeFlags& flags);
+
+// The options the flags describe, validated; UsageError naming the flag otherwise (also for
+// a material parameter the chosen material never reads).
+prt::BakeOptions resolve_bake_flags(const BakeFlags& flags);
 
 }  // namespace prtr_app
