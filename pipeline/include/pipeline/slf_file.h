@@ -7,8 +7,10 @@
 // row as channels x order^2 x columns, so the set says order 1, channels 3, columns Z W;
 // its channel-major reading of PRT transfer does not apply, the row is the SLF's as it is.
 // The renderer's model (render/slf_model.h) takes it unchanged: texel_cluster and
-// texel_weights scatter cluster_of and weights back to the atlas's texels, and view map
-// (cluster, 0) is means row cluster, (cluster, 1 + j) bases row j of that cluster.
+// texel_weights scatter cluster_of and weights back to the atlas's texels (row r is texel
+// prt::slf_rows(atlas)[r]), and view map (cluster, 0) is means row cluster, (cluster, 1 + j)
+// bases row j of that cluster. The atlas itself is not stored: meshes::make_atlas(mesh,
+// width, height) is deterministic, so the mesh the content hash names rebuilds it.
 //
 // Layout, little-endian: a 128-byte versioned header (common/binary_file.h):
 //   0 magic "PRTRSLFC", 8 u32 version, 12 u32 header bytes (128),
