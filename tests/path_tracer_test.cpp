@@ -144,6 +144,39 @@ TEST(PathTracer, MisEstimateMatchesADenseQuadrature) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(l[c], expected[c], 0.015 * expected[c]) << c;
 }
 
+TEST(ProbeSampler, DensityMatchesItsSamplesAndIntegratesTheProbe) {
+  // A bright lobe on a dim sky, and a black cap that must never be drawn.
+  const Eigen::Vector3d sun = Eigen::Vector3d(-0.3, 0.5, 0.8).normalized();
+  const probes::Probe probe = probes::make_from_function(128, 64, [&](const Eigen::Vector3d& d) {
+    if (d.y() < -0.9) return probes::Rgb(0, 0, 0);
+    const double lobe = std::exp(60.0 * (d.dot(sun) - 1.0));
+    return probes::Rgb(float(0.3 + 20 * lobe), float(0.2 + 10 * lobe), float(0.1 + 5 * lobe));
+  });
+  const prt::ProbeSampler sampler(probe);
+  ASSERT_FALSE(sampler.empty());
+  prt::RandomStream rng{42, 0};
+  constexpr int kSamples = 200000;
+  Eigen::Vector3d integral = Eigen::Vector3d::Zero();
+  for (int k = 0; k < kSamples; ++k) {
+    double pdf = 0;
+    const double u0 = rng.next(), u1 = rng.next(), u2 = rng.next(), u3 = rng.next();
+    const Eigen::Vector3d d = sampler.sample(u0, u1, u2, u3, &pdf);
+    ASSERT_GT(pdf, 0);
+    ASSERT_NEAR(d.norm(), 1, 1e-9);
+    ASSERT_NEAR(sampler.pdf(d), pdf, 1e-9 * pdf) << k;
+    // Never inside the black cap, but in its rim: texels within one of a lit one (2.8 degrees
+    // a row here) have density, since bilinear lookups there are not black.
+    ASSERT_GE(d.y(), -0.94);
+    integral += probe.lookup(d).cast<double>() / pdf;
+  }
+  integral /= kSamples;
+  // The oracle: the probe's own solid-angle weighted mean, times 4 pi. Bilinear lookups and
+  // texel means differ by the interpolation, well under a percent for this smooth map.
+  const Eigen::Vector3d expected = 4 * kPi * probe.mean_radiance().cast<double>();
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(integral[c], expected[c], 0.01 * expected[c]) << c;
+  EXPECT_TRUE(prt::ProbeSampler(probes::make_constant(8, 4, probes::Rgb(0, 0, 0))).empty());
+}
+
 TEST(PathTracer, InsideAClosedBoxIsBlack) {
   meshes::Mesh lid = meshes::make_plane(2.f, 4, 1.f);
   for (meshes::Triangle& t : lid.triangles) std::swap(t[1], t[2]);  // face down, into the box

@@ -62,9 +62,9 @@ class ProbeSampler {
  private:
   int width_ = 0, height_ = 0;
   double total_ = 0;
-  std::vector<double> row_cdf_;     // height + 1
-  std::vector<double> column_cdf_;  // height x (width + 1), each row's own
-  std::vector<double> texel_pdf_;   // probability / solid angle, per texel
+  std::vector<float> alias_prob_;     // per texel: keep it with this probability,
+  std::vector<std::uint32_t> alias_;  // else take this texel (Vose's alias table)
+  std::vector<double> texel_pdf_;     // probability / solid angle, per texel
 };
 
 // A point on the surface: its position, the unit face normal (for ray offsets and back
