@@ -49,7 +49,7 @@ run mesh a.obj --bogus; expect_code 2; check "unknown flag exits 2" $?
 # and its ~200 process starts cost several minutes there.
 numeric_flags=0
 others=("-1" "abc" "1e400" "99999999999999999999999")
-subcommands=(bake compress merge mesh probe info render relight overdraw view gl-info)
+subcommands=(bake compress merge mesh probe info render relight overdraw view gl-info slf path-trace)
 [[ ${PRTR_CLI_SWEEP:-1} == 0 ]] && { subcommands=(); skip "numeric flag sweep (PRTR_CLI_SWEEP=0)"; }
 for sub in "${subcommands[@]}"; do
   while read -r flag; do
@@ -441,6 +441,20 @@ run relight "$tmp/cube.obj" --probe x.exr --exposure nan
 expect_code 2 && [[ $err == *--exposure* ]]; check "relight: --exposure nan is a usage error naming it" $?
 run overdraw "$tmp/cube.obj" --probe x.exr --alpha inf
 expect_code 2 && [[ $err == *--alpha* ]]; check "overdraw: --alpha inf is a usage error naming it" $?
+
+# prtr slf and prtr path-trace on the cube under the forest probe: the report's figures and
+# the .slfc magic; an atlas too small for the mesh and a malformed --samples are usage errors.
+if [[ -f $forest ]]; then
+  run slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/cube.slfc" --no-cache -q
+  expect_code 0 && [[ $out == *"data generation"* && $out == *"compression ratio"* && $out == *"RMS error"* ]]; check "slf: exits 0 and reports times, ratio and error" $?
+  [[ $(head -c 8 "$tmp/cube.slfc" 2>/dev/null) == PRTRSLFC ]]; check "slf writes a .slfc file" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --samples 4x4 -o "$tmp/x.slfc" --no-cache -q
+  expect_code 2 && [[ $err == *"too small"* ]]; check "slf: an atlas too small for the mesh is a usage error" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --samples 32 -o "$tmp/x.slfc" -q
+  expect_code 2 && [[ $err == *--samples* ]]; check "slf: --samples without WxH is a usage error naming it" $?
+  run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 -o "$tmp/pt.exr" -q
+  expect_code 0 && [[ -s $tmp/pt.exr ]]; check "path-trace writes an EXR" $?
+fi
 
 echo "cli: $passed passed, $failed failed"
 ((failed == 0))

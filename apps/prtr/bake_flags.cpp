@@ -32,23 +32,7 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
   add_checked_option(cmd, "--bounces", f.bake.bounces, "Interreflection passes (0: shadows only)",
                      integer_in(0, 16));
   add_checked_option(cmd, "--seed", f.bake.seed, "Seed of the direction set", unsigned_integer());
-  add_checked_option(cmd, "--material", f.material, "Reflectance model",
-                     CLI::IsMember({"lambert", "phong", "cook-torrance"}));
-  cmd->add_option("--albedo", f.albedo, "Diffuse albedo: one value (grey) or R,G,B")
-      ->capture_default_str();
-  add_checked_option(cmd, "--specular", f.bake.material.specular,
-                     "Specular reflectance (phong, cook-torrance)", number_in(0, 1));
-  add_checked_option(cmd, "--exponent", f.bake.material.exponent, "Phong exponent",
-                     number_in(0, 10000));
-  // (0, 1]: number_in takes the closed range; Material::validate refuses 0 by name.
-  add_checked_option(cmd, "--roughness", f.bake.material.roughness,
-                     "Cook-Torrance Beckmann roughness", number_in(0, 1));
-  add_checked_option(cmd, "--f0", f.bake.material.f0,
-                     "Cook-Torrance Fresnel reflectance at normal incidence", number_in(0, 1));
-  add_checked_option(
-      cmd, "--masking", f.masking,
-      "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the thesis's)",
-      CLI::IsMember({"smith", "v-groove"}));
+  add_material_flags(cmd, f.material);
   cmd->add_option("--view-fit", f.view_fit,
                   "Glossy: how the view side fits exit radiance; hemisphere is the thesis's "
                   "projection (docs/ARCHITECTURE.md, \"The view side\")")
@@ -60,28 +44,58 @@ void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
       number_in(0, 0.01));
 }
 
-prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
-  prt::BakeOptions bake = f.bake;
-  bake.kind = f.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;
-  bake.material.kind = prt::kMaterialNames.parse(f.material);
-  bake.material.albedo = parse_albedo(f.albedo);
-  bake.material.masking = prt::kMaskingNames.parse(f.masking);
-  bake.view_fit = prt::kViewFitNames.parse(f.view_fit);
+void add_material_flags(CLI::App* cmd, MaterialFlags& f) {
+  f.command = cmd;
+  add_checked_option(cmd, "--material", f.material, "Reflectance model",
+                     CLI::IsMember({"lambert", "phong", "cook-torrance"}));
+  cmd->add_option("--albedo", f.albedo, "Diffuse albedo: one value (grey) or R,G,B")
+      ->capture_default_str();
+  add_checked_option(cmd, "--specular", f.values.specular,
+                     "Specular reflectance (phong, cook-torrance)", number_in(0, 1));
+  add_checked_option(cmd, "--exponent", f.values.exponent, "Phong exponent", number_in(0, 10000));
+  // (0, 1]: number_in takes the closed range; Material::validate refuses 0 by name.
+  add_checked_option(cmd, "--roughness", f.values.roughness, "Cook-Torrance Beckmann roughness",
+                     number_in(0, 1));
+  add_checked_option(cmd, "--f0", f.values.f0,
+                     "Cook-Torrance Fresnel reflectance at normal incidence", number_in(0, 1));
+  add_checked_option(
+      cmd, "--masking", f.masking,
+      "Cook-Torrance masking-shadowing: smith (height-correlated) or v-groove (the thesis's)",
+      CLI::IsMember({"smith", "v-groove"}));
+}
+
+prt::Material resolve_material_flags(const MaterialFlags& f) {
+  prt::Material m = f.values;
+  m.kind = prt::kMaterialNames.parse(f.material);
+  m.albedo = parse_albedo(f.albedo);
+  m.masking = prt::kMaskingNames.parse(f.masking);
   // A flag the chosen material never reads is a mistake worth reporting.
-  const auto kind = bake.material.kind;
   auto unused = [&](const char* flag, bool used) {
     if (f.command && f.command->count(flag) && !used) {
       throw UsageError(std::string(flag) + " does not apply to --material " + f.material);
     }
   };
-  unused("--exponent", kind == prt::MaterialKind::kPhong);
-  unused("--roughness", kind == prt::MaterialKind::kCookTorrance);
-  unused("--f0", kind == prt::MaterialKind::kCookTorrance);
-  unused("--masking", kind == prt::MaterialKind::kCookTorrance);
+  unused("--exponent", m.kind == prt::MaterialKind::kPhong);
+  unused("--roughness", m.kind == prt::MaterialKind::kCookTorrance);
+  unused("--f0", m.kind == prt::MaterialKind::kCookTorrance);
+  unused("--masking", m.kind == prt::MaterialKind::kCookTorrance);
+  unused("--specular", m.kind != prt::MaterialKind::kLambert);
+  if (m.kind == prt::MaterialKind::kLambert) m.specular = 0.f;
+  try {
+    m.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return m;
+}
+
+prt::BakeOptions resolve_bake_flags(const BakeFlags& f) {
+  prt::BakeOptions bake = f.bake;
+  bake.kind = f.kind == "diffuse" ? prt::TransferKind::kDiffuse : prt::TransferKind::kGlossy;
+  bake.material = resolve_material_flags(f.material);
+  bake.view_fit = prt::kViewFitNames.parse(f.view_fit);
   if (f.command && f.command->count("--view-fit") && f.kind == "diffuse")
     throw UsageError("--view-fit applies to --kind glossy only");
-  unused("--specular", kind != prt::MaterialKind::kLambert);
-  if (kind == prt::MaterialKind::kLambert) bake.material.specular = 0.f;
   try {
     prt::validate(bake);
   } catch (const std::invalid_argument& e) {

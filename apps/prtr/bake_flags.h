@@ -11,9 +11,22 @@
 
 namespace prtr_app {
 
+// The material flags (--material, --albedo, --specular, --exponent, --roughness, --f0,
+// --masking): part of the bake flags, and alone for the commands that shade without an SH
+// bake (prtr slf, prtr path-trace).
+struct MaterialFlags {
+  std::string material = "phong", albedo = "0.5", masking = "smith";
+  prt::Material values;
+  CLI::App* command = nullptr;
+};
+void add_material_flags(CLI::App* command, MaterialFlags& flags);
+// The material, validated; UsageError naming the flag otherwise (also for a parameter the
+// chosen material never reads).
+prt::Material resolve_material_flags(const MaterialFlags& flags);
+
 struct BakeFlags {
-  std::string kind = "glossy", material = "phong", albedo = "0.5";
-  std::string masking = "smith", view_fit = "least-squares";
+  std::string kind = "glossy", view_fit = "least-squares";
+  MaterialFlags material;  // --material and its parameters, resolved into bake.material
   prt::BakeOptions bake;
   CLI::App* command = nullptr;  // to tell which flags were given
 };

@@ -1,0 +1,175 @@
+// prtr slf MESH --probe P -o OUT.slfc: a surface light field (SLF paper, Secs. 3.1-3.2): a
+// per-triangle atlas of --samples texels, the exit radiance of every texel toward --directions
+// cells path traced under the probe (cached), CPCA of that matrix, and the figures the
+// paper's Table 1 reports: data generation time, compression time, compression ratio, and
+// the RMS error of the compressed matrix against the baked one.
+#include "bake_flags.h"
+#include "commands.h"
+#include "common/json.h"
+#include "compress_flags.h"
+#include "flag_checks.h"
+#include "mesh_flags.h"
+#include "progress_bar.h"
+
+#include "meshes/load.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/slf.h"
+#include "probes/load.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+namespace prtr_app {
+using common::dump_json;
+using common::Json;
+// Named rather than anonymous: a unity build compiles every command in one unit.
+namespace cmd_slf {
+
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string mesh, probe, output, cache, samples = "256x256", directions = "32x16", rows;
+  MaterialFlags material;
+  MeshFlags mesh_flags;
+  CompressFlags compress;
+  int spp = 16, bounces = 1;
+  std::uint64_t seed = 1;
+  double ray_offset = 1e-4;
+  bool quiet = false, json = false, no_cache = false;
+};
+
+// "AxB" with both in [lo, hi]; UsageError naming the flag otherwise.
+std::pair<int, int> parse_size(const std::string& text, const char* flag, int lo, int hi) {
+  int a = 0, b = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
+      a < lo || a > hi || b < lo || b > hi) {
+    throw UsageError(std::string(flag) + " " + text + ": expected WxH with both in [" +
+                     std::to_string(lo) + ", " + std::to_string(hi) + "] (e.g. 256x256)");
+  }
+  return {a, b};
+}
+
+// "A:B" as rows [A, B); {0, 0} for all rows.
+std::pair<std::uint64_t, std::uint64_t> parse_rows(const std::string& text) {
+  if (text.empty()) return {0, 0};
+  unsigned long long a = 0, b = 0;
+  char colon = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%llu%c%llu%c", &a, &colon, &b, &extra) != 3 || colon != ':' ||
+      b <= a || b > (1ULL << 32)) {
+    throw UsageError("--rows " + text + ": expected FIRST:END with FIRST < END (e.g. 0:65536)");
+  }
+  return {a, b};
+}
+
+void add_flags(CLI::App* cmd, Options& o) {
+  cmd->add_option("MESH", o.mesh, "Mesh (" + std::string(meshes::kMeshFormats) + ")")->required();
+  cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
+  cmd->add_option("-o,--output", o.output, "Compressed surface light field to write (.slfc)")
+      ->required();
+  cmd->add_option("--samples", o.samples,
+                  "Atlas size WxH in texels: the surface samples (one chart per triangle)")
+      ->capture_default_str();
+  cmd->add_option("--directions", o.directions,
+                  "Direction grid ZxW: azimuth x polar cells over the sphere")
+      ->capture_default_str();
+  add_checked_option(cmd, "--spp", o.spp, "Path-traced samples per texel and direction cell",
+                     integer_in(1, 65536));
+  add_checked_option(cmd, "--bounces", o.bounces, "Interreflections (0: direct light, shadows)",
+                     integer_in(0, 16));
+  add_checked_option(cmd, "--seed", o.seed, "Seed of the path tracer's random numbers",
+                     unsigned_integer());
+  add_checked_option(cmd, "--ray-offset", o.ray_offset,
+                     "Secondary rays start this x the bbox diagonal off the surface",
+                     number_in(1e-8, 0.1));
+  cmd->add_option("--rows", o.rows,
+                  "Bake and compress only rows FIRST:END of the matrix (a part or a "
+                  "measurement; the renderer refuses such a file)");
+  add_material_flags(cmd, o.material);
+  add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
+  add_mesh_flags(cmd, o.mesh_flags);
+  cmd->add_option("--cache", o.cache, "Cache directory (default $PRTR_CACHE or ~/.cache/prtr)");
+  cmd->add_flag("--no-cache", o.no_cache, "Bake in memory, neither reading nor writing the cache");
+  cmd->add_flag("--json", o.json, "Print the report as one JSON line instead");
+  cmd->add_flag("-q,--quiet", o.quiet, "No progress bar");
+}
+
+void run(const Options& o, CLI::App*) {
+  check_outputs({{"-o", o.output}}, {{"MESH", o.mesh}, {"--probe", o.probe}});
+  pipeline::SlfSettings settings;
+  std::tie(settings.atlas_width, settings.atlas_height) =
+      parse_size(o.samples, "--samples", 4, 8192);
+  std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
+      parse_size(o.directions, "--directions", 1, 4096);
+  std::tie(settings.bake.first_row, settings.bake.end_row) = parse_rows(o.rows);
+  settings.bake.spp = o.spp;
+  settings.bake.bounces = o.bounces;
+  settings.bake.seed = o.seed;
+  settings.bake.ray_offset = o.ray_offset;
+  settings.bake.material = resolve_material_flags(o.material);
+  settings.compress = resolve_compress_flags(o.compress);
+  if (settings.compress.alpha > 0 || settings.compress.overdraw_reduction)
+    throw UsageError(
+        "--alpha and --overdraw-reduction need mesh vertices; an SLF's rows are "
+        "atlas texels");
+  try {
+    settings.bake.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
+  const probes::Probe probe = probes::load_probe(o.probe);
+  const fs::path cache = o.no_cache        ? fs::path()
+                         : o.cache.empty() ? pipeline::default_cache_dir()
+                                           : fs::path(o.cache);
+  pipeline::SlfRun r;
+  try {
+    r = pipeline::make_slf(mesh, o.mesh, probe, fs::path(o.probe).filename().string(), settings,
+                           cache, stderr_reporter(o.quiet || o.json));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());  // an atlas too small for the mesh, too many clusters
+  }
+  pipeline::write_slfc(o.output, r.slf);
+
+  const std::uint64_t file_bytes = fs::file_size(o.output);
+  if (o.json) {
+    Json j;
+    j["rows"] = r.slf.bake.row_count;
+    j["atlas_rows"] = r.slf.bake.rows;
+    j["directions"] = r.slf.bake.grid.directions();
+    j["data_generation_seconds"] = r.bake_seconds;
+    j["bake_cached"] = r.bake_cached;
+    j["compression_seconds"] = r.compress_seconds;
+    j["compression_ratio"] = r.ratio;
+    j["rms_error"] = r.rms_error;
+    j["relative_rms_error"] = r.relative_rms_error;
+    j["file_bytes"] = file_bytes;
+    std::printf("%s\n", dump_json(j).c_str());
+    return;
+  }
+  std::printf("wrote %s (%s)\n", o.output.c_str(), format_bytes(file_bytes).c_str());
+  std::printf("rows (texels)      %llu of %llu, x %d directions x 3 channels\n",
+              static_cast<unsigned long long>(r.slf.bake.row_count),
+              static_cast<unsigned long long>(r.slf.bake.rows), r.slf.bake.grid.directions());
+  std::printf("data generation    %.2f s%s\n", r.bake_seconds,
+              r.bake_cached ? " (read from the cache; the bake itself was earlier)" : "");
+  std::printf("compression        %.2f s (K = %d clusters, N = %d components)\n",
+              r.compress_seconds, r.slf.set.cluster_count, r.slf.set.component_count);
+  std::printf("compression ratio  %.1f : 1 (%llu floats raw, %llu compressed)\n", r.ratio,
+              static_cast<unsigned long long>(r.raw_floats),
+              static_cast<unsigned long long>(r.compressed_floats));
+  std::printf("RMS error          %.4g (%.3g%% of the matrix's RMS)\n", r.rms_error,
+              100 * r.relative_rms_error);
+}
+
+}  // namespace cmd_slf
+
+Runner add_slf_command(CLI::App& app) {
+  return add_command(app, "slf",
+                     "Bake a surface light field (path traced under a probe) and compress it "
+                     "with CPCA into a .slfc file",
+                     cmd_slf::add_flags, cmd_slf::run);
+}
+
+}  // namespace prtr_app

@@ -1,0 +1,116 @@
+// prt/slf_bake.h: the surface light field's data (SLF paper, Sec. 3.1): for every atlas texel
+// that a lookup can read (meshes/atlas.h), the exit radiance toward every direction of the
+// grid (prt/slf_directions.h) under a fixed probe, path traced (prt/path_tracer.h).
+//
+// The SLF matrix has one row per owned texel, in texel order (row-major over the atlas, the
+// texels of triangle -1 skipped: slf_rows), and 3 Z W columns, (direction j Z + i, channel),
+// RGB innermost, as render/slf_model.h lays out the view maps. A texel samples its surface
+// point (the atlas's barycentrics) with the interpolated per-vertex frame. Entry (t, d) is the
+// mean radiance over direction d's cell, not its centre: each of the `spp` samples takes a
+// direction uniformly distributed in solid angle inside the cell (azimuth uniform, cosine of
+// the polar angle uniform), so the grid is prefiltered. A view below the shading tangent
+// plane gets the radiance of the most grazing view above it (prt::clamp_to_horizon), so
+// silhouettes do not go dark.
+//
+// The .slf file holds the matrix (or a range of its rows, for processes that bake parts)
+// after a 128-byte versioned header (common/binary_file.h), little-endian:
+//   0 magic "PRTRSLFM", 8 u32 version, 12 u32 header bytes (128),
+//   16 u32 atlas width, 20 u32 atlas height, 24 u32 Z (azimuth cells), 28 u32 W (polar cells),
+//   32 u32 spp, 36 u32 bounces, 40 u32 material kind, 44 u32 masking, 48 u64 seed,
+//   56 u64 mesh content hash, 64 f32[3] albedo, 76 f32 specular, 80 f32 exponent,
+//   84 f32 roughness, 88 f32 f0, 92 u32 rows of the whole matrix, 96 u32 first row stored,
+//   100 u32 rows stored, 104 u64 FNV-1a of the payload, 112 u64 FNV-1a of the probe's texels,
+//   120 u64 FNV-1a of bytes [0, 120),
+// then rows stored x 3 Z W float32, then nothing.
+#pragma once
+
+#include "meshes/atlas.h"
+#include "meshes/mesh.h"
+#include "probes/probe.h"
+#include "prt/material.h"
+#include "prt/slf_directions.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace prt {
+
+inline constexpr std::uint32_t kSlfFileVersion = 1;
+
+class SlfFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct SlfBakeOptions {
+  SlfGrid grid;
+  int spp = 16;     // samples per texel and direction, in [1, 65536]
+  int bounces = 1;  // interreflections (prt/path_tracer.h)
+  std::uint64_t seed = 1;
+  Material material;
+  double ray_offset = 1e-4;
+  // Rows [first_row, end_row) of the matrix; end_row 0 means to the last row.
+  std::uint64_t first_row = 0, end_row = 0;
+  // Rows per block written at once (0: about 16 MiB of floats).
+  std::uint64_t block_rows = 0;
+  // Rows done and rows of the range; from worker threads, one at a time, at most every 50 ms
+  // and once at the end.
+  std::function<void(std::uint64_t done, std::uint64_t total)> progress;
+  // Throws std::invalid_argument naming the option as its CLI flag.
+  void validate() const;
+};
+
+// Everything about a matrix but its values.
+struct SlfShape {
+  int atlas_width = 0, atlas_height = 0;
+  SlfGrid grid;
+  int spp = 0, bounces = 0;
+  std::uint64_t seed = 0;
+  Material material;
+  std::uint64_t mesh_hash = 0, probe_hash = 0;
+  std::uint64_t rows = 0;                      // owned texels of the atlas
+  std::uint64_t first_row = 0, row_count = 0;  // the rows this matrix or file holds
+  std::size_t columns() const { return std::size_t(3) * std::size_t(grid.directions()); }
+};
+
+struct SlfMatrix {
+  SlfShape shape;
+  std::vector<float> data;  // row_count x columns, row-major
+  const float* row(std::uint64_t r) const { return data.data() + r * shape.columns(); }
+};
+
+// The owned texels of the atlas in texel order: row r of the SLF matrix samples texel
+// slf_rows(atlas)[r] (y * width + x).
+std::vector<std::uint32_t> slf_rows(const meshes::Atlas& atlas);
+
+// FNV-1a of the probe's size and texels (the file records which probe lit the bake).
+std::uint64_t probe_hash(const probes::Probe& probe);
+
+// The rows of the options' range, in memory. The mesh needs frames; `atlas` must be
+// make_atlas(mesh, ...) (its triangle count is checked). Throws std::invalid_argument for bad
+// options, RayError if Embree fails.
+SlfMatrix bake_slf(const meshes::Mesh& mesh, const meshes::Atlas& atlas, const probes::Probe& probe,
+                   const SlfBakeOptions& options);
+
+// The same, written to `path` block by block (memory holds one block), atomically: nothing
+// appears at `path` unless the whole range was baked. Returns the shape written.
+SlfShape bake_slf_to_file(const meshes::Mesh& mesh, const meshes::Atlas& atlas,
+                          const probes::Probe& probe, const SlfBakeOptions& options,
+                          const std::filesystem::path& path);
+
+// Atomic; refuses (std::invalid_argument naming the file) what read_slf would refuse.
+void write_slf(const std::filesystem::path& path, const SlfMatrix& matrix);
+// Checks magic, version, fields, header checksum and the file size before reading, then the
+// payload checksum and finite values. SlfFileError naming the file, the problem and the fix.
+SlfMatrix read_slf(const std::filesystem::path& path);
+SlfShape read_slf_header(const std::filesystem::path& path);
+
+// Parts baked as row ranges, read and joined in row order into the whole matrix. Throws
+// SlfFileError when they were baked with different settings or do not cover every row once.
+SlfMatrix join_slf_parts(const std::vector<std::filesystem::path>& parts);
+
+}  // namespace prt
