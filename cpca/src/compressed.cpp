@@ -34,6 +34,10 @@ void validate(const CompressedSet& set) {
           "channel count " + std::to_string(set.channels) + " is not 1 or 3");
   require(set.columns == 1 || set.columns == set.coefficient_count(),
           "column count " + std::to_string(set.columns) + " is neither 1 nor n");
+  validate_arrays(set);
+}
+
+void validate_arrays(const CompressedSet& set) {
   require(set.vertex_count >= 1, "no vertices");
   require(set.cluster_count >= 1 && std::uint64_t(set.cluster_count) <= set.vertex_count,
           "cluster count " + std::to_string(set.cluster_count) + " is outside 1..vertices");

@@ -19,7 +19,7 @@ namespace slf_from_compressed_checks {
 SlfModel slf_model_from_compressed(const meshes::Mesh& mesh, const meshes::Atlas& atlas,
                                    const prt::SlfGrid& grid, const cpca::CompressedSet& set) {
   grid.validate();
-  cpca::validate(set);
+  cpca::validate_arrays(set);
   const std::size_t triangles = mesh.triangle_count();
   if (triangles == 0) slf_from_compressed_checks::refuse("the mesh has no triangles");
   if (atlas.uv.size() != 3 * triangles)

@@ -98,5 +98,8 @@ void reconstruct_vertex(const CompressedSet& set, std::uint64_t p, float* out);
 // throws std::invalid_argument naming the first problem. Used by the file loader and by
 // code that builds sets by hand.
 void validate(const CompressedSet& set);
+// The same checks without the PRT layout's (order 1..10, columns 1 or n): for sets whose rows
+// are another matrix's, such as a surface light field's 3 Z W radiances.
+void validate_arrays(const CompressedSet& set);
 
 }  // namespace cpca
