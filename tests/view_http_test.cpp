@@ -74,6 +74,11 @@ TEST(HttpRequestHead, LimitsRefuseAsSoonAsPassed) {
   // Unfinished: a target still arriving past the limit, 1 MB of it.
   EXPECT_EQ(parse("GET /" + std::string(1 << 20, 'a'), limits).status, 414);
   EXPECT_EQ(parse(std::string(1 << 20, 'a'), limits).status, 400);  // no method, no target
+  // The line's bound holds whole or cut: a 60-byte method beside a 100-byte target.
+  const std::string long_method = std::string(60, 'M') + " " + long_target.substr(0, 100);
+  EXPECT_EQ(parse(long_method + " HTTP/1.1\r\n\r\n", limits).status, 400);
+  EXPECT_EQ(parse(long_method + " HTTP/1", limits).status, 400);
+  EXPECT_EQ(parse(std::string(50, 'M') + " /a HTTP/1.1\r\n\r\n", limits).state, State::complete);
   const std::string line = "GET / HTTP/1.1\r\n";
   EXPECT_EQ(parse(line + "X: " + std::string(1 << 20, 'b'), limits).status, 431);
   EXPECT_EQ(parse(line + "X: " + std::string(196, 'b') + "\r\n\r\n", limits).status, 431);

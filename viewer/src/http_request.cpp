@@ -88,15 +88,22 @@ HeadParse check_partial_request_line(std::string_view partial, const HttpLimits&
   if (partial.size() <= limits.max_target + kRequestLineExtra) return HeadParse{};
   const std::size_t space = partial.find(' ');
   if (space != std::string_view::npos && space <= kRequestLineExtra &&
-      is_token(partial.substr(0, space)))
-    return refused(414,
-                   "request target longer than " + std::to_string(limits.max_target) + " bytes");
+      is_token(partial.substr(0, space))) {
+    const std::string_view rest = partial.substr(space + 1);
+    if (rest.substr(0, rest.find(' ')).size() > limits.max_target)
+      return refused(414,
+                     "request target longer than " + std::to_string(limits.max_target) + " bytes");
+  }
   return refused(400, "request line longer than " +
                           std::to_string(limits.max_target + kRequestLineExtra) + " bytes");
 }
 
 // Fills method, target and version from a complete request line; a refusal when it is bad.
 HeadParse parse_request_line(std::string_view line, const HttpLimits& limits, HttpHead& head) {
+  // The same bound as while it arrives, so that the answer never depends on how it was cut.
+  if (HeadParse bad = check_partial_request_line(line, limits);
+      bad.state == HeadParse::State::refused)
+    return bad;
   const std::size_t first = line.find(' ');
   const std::size_t second = first == std::string_view::npos ? first : line.find(' ', first + 1);
   if (second == std::string_view::npos || line.find(' ', second + 1) != std::string_view::npos)
