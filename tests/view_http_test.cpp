@@ -84,8 +84,30 @@ TEST(HttpRequestHead, LimitsRefuseAsSoonAsPassed) {
   EXPECT_EQ(parse(line + "X: " + std::string(196, 'b') + "\r\n\r\n", limits).status, 431);
   EXPECT_EQ(parse(line + "X: " + std::string(150, 'b') + "\r\n\r\n", limits).state,
             State::complete);
+  limits.max_field_line = 120;  // one line: its bytes through the LF
+  EXPECT_EQ(parse(line + "X: " + std::string(115, 'b') + "\r\n\r\n", limits).state,
+            State::complete);
+  EXPECT_EQ(parse(line + "X: " + std::string(116, 'b') + "\r\n\r\n", limits).status, 431);
+  EXPECT_EQ(parse(line + "X: " + std::string(118, 'b'), limits).status, 431);
   EXPECT_EQ(parse(line + "A: 1\r\nB: 2\r\nC: 3\r\n\r\n", limits).state, State::complete);
   EXPECT_EQ(parse(line + "A: 1\r\nB: 2\r\nC: 3\r\nD: 4\r\n\r\n", limits).status, 431);
+}
+
+TEST(HttpRequestHead, AbsoluteAndAsteriskForms) {
+  // RFC 9112 Sec. 3.2.2: the authority of an absolute-form target replaces the Host field.
+  const HeadParse p = parse("GET http://LocalHost:8080/frame?w=1 HTTP/1.1\r\nHost: evil:1\r\n\r\n");
+  ASSERT_EQ(p.state, State::complete) << p.reason;
+  EXPECT_EQ(p.head.target, "/frame?w=1");
+  ASSERT_NE(p.head.field("host"), nullptr);
+  EXPECT_EQ(*p.head.field("host"), "LocalHost:8080");
+  EXPECT_EQ(p.head.fields.size(), 1u);
+  EXPECT_EQ(parse("GET HTTP://h:1 HTTP/1.1\r\n\r\n").head.target, "/");
+  EXPECT_EQ(parse("GET http://h:1?x HTTP/1.1\r\n\r\n").head.target, "/?x");
+  EXPECT_EQ(parse("OPTIONS * HTTP/1.1\r\nHost: h:1\r\n\r\n").head.target, "*");
+  for (const char* bad : {"GET * HTTP/1.1\r\n\r\n", "GET http:// HTTP/1.1\r\n\r\n",
+                          "GET http:///x HTTP/1.1\r\n\r\n", "GET https://h/ HTTP/1.1\r\n\r\n",
+                          "GET http://u@h/ HTTP/1.1\r\n\r\n", "GET h:1/x HTTP/1.1\r\n\r\n"})
+    EXPECT_EQ(parse(bad).status, 400) << bad;
 }
 
 TEST(HttpRequestHead, MalformedHeadsAreRefused) {
@@ -94,7 +116,7 @@ TEST(HttpRequestHead, MalformedHeadsAreRefused) {
       {"GET  / HTTP/1.1\r\n\r\n", 400},
       {"GET / HTTP/1.1 x\r\n\r\n", 400},
       {"G(T / HTTP/1.1\r\n\r\n", 400},
-      {"GET http://evil/ HTTP/1.1\r\n\r\n", 400},
+      {"GET ftp://evil/ HTTP/1.1\r\n\r\n", 400},
       {"GET * HTTP/1.1\r\n\r\n", 400},
       {"GET /\x01 HTTP/1.1\r\n\r\n", 400},
       {"GET / HTTP/2.0\r\n\r\n", 505},

@@ -98,8 +98,29 @@ HeadParse check_partial_request_line(std::string_view partial, const HttpLimits&
                           std::to_string(limits.max_target + kRequestLineExtra) + " bytes");
 }
 
+// The origin-form of a target, and the authority of an absolute-form one (RFC 9112 Sec. 3.2);
+// false for any other form.
+bool origin_form(std::string_view method, std::string_view target, std::string& path,
+                 std::string& authority) {
+  if (target.front() == '/' || (target == "*" && method == "OPTIONS")) {
+    path = std::string(target);
+    return true;
+  }
+  constexpr std::string_view scheme = "http://";
+  if (target.size() <= scheme.size() || !equal_ignoring_case(target.substr(0, 7), scheme))
+    return false;
+  const std::string_view rest = target.substr(scheme.size());
+  const std::size_t end = std::min(rest.find_first_of("/?#"), rest.size());
+  authority = std::string(rest.substr(0, end));
+  if (authority.empty() || authority.find('@') != std::string::npos) return false;
+  path = rest.substr(end).empty() || rest[end] != '/' ? "/" : "";
+  path += rest.substr(end);
+  return true;
+}
+
 // Fills method, target and version from a complete request line; a refusal when it is bad.
-HeadParse parse_request_line(std::string_view line, const HttpLimits& limits, HttpHead& head) {
+HeadParse parse_request_line(std::string_view line, const HttpLimits& limits, HttpHead& head,
+                             std::string& authority) {
   // The same bound as while it arrives, so that the answer never depends on how it was cut.
   if (HeadParse bad = check_partial_request_line(line, limits);
       bad.state == HeadParse::State::refused)
@@ -118,8 +139,9 @@ HeadParse parse_request_line(std::string_view line, const HttpLimits& limits, Ht
   if (target.empty() ||
       !std::all_of(target.begin(), target.end(), [](char c) { return c > 0x20 && c < 0x7f; }))
     return refused(400, "malformed request target");
-  if (target.front() != '/')
-    return refused(400, "request target must be a path (origin-form, starting with '/')");
+  std::string path;
+  if (!origin_form(method, target, path, authority))
+    return refused(400, "request target must be a path starting with '/' or http://host/path");
   const bool shaped = version.size() == 8 && version.substr(0, 5) == "HTTP/" && version[6] == '.' &&
                       version[5] >= '0' && version[5] <= '9' && version[7] >= '0' &&
                       version[7] <= '9';
@@ -128,7 +150,7 @@ HeadParse parse_request_line(std::string_view line, const HttpLimits& limits, Ht
     return refused(version[5] > '1' ? 505 : 400,
                    std::string(version) + " is not supported; use HTTP/1.1");
   head.method = std::string(method);
-  head.target = std::string(target);
+  head.target = std::move(path);
   head.minor_version = version[7] - '0';
   return HeadParse{};
 }
@@ -212,7 +234,8 @@ HeadParse parse_request_head(std::string_view buffer, const HttpLimits& limits) 
   std::size_t next = 0;
   if (!hrp::next_line(buffer, pos, line, next))
     return hrp::check_partial_request_line(buffer.substr(pos), limits);
-  if (HeadParse bad = hrp::parse_request_line(line, limits, result.head);
+  std::string authority;
+  if (HeadParse bad = hrp::parse_request_line(line, limits, result.head, authority);
       bad.state == HeadParse::State::refused)
     return bad;
   const std::size_t fields_start = next;
@@ -222,12 +245,22 @@ HeadParse parse_request_head(std::string_view buffer, const HttpLimits& limits) 
     if ((whole ? next : buffer.size()) - fields_start > limits.max_header_bytes)
       return hrp::refused(
           431, "header section longer than " + std::to_string(limits.max_header_bytes) + " bytes");
+    if ((whole ? next : buffer.size()) - pos > limits.max_field_line)
+      return hrp::refused(
+          431, "header line longer than " + std::to_string(limits.max_field_line) + " bytes");
     if (!whole) return HeadParse{};
     if (line.empty()) break;
     if (HeadParse bad = hrp::parse_field_line(line, limits, result.head);
         bad.state == HeadParse::State::refused)
       return bad;
     pos = next;
+  }
+  if (!authority.empty()) {
+    std::vector<std::pair<std::string, std::string>>& fields = result.head.fields;
+    fields.erase(std::remove_if(fields.begin(), fields.end(),
+                                [](const auto& field) { return field.first == "host"; }),
+                 fields.end());
+    fields.emplace_back("host", std::move(authority));
   }
   result.state = HeadParse::State::complete;
   result.length = next;

@@ -19,6 +19,7 @@ namespace viewer::detail {
 
 struct HttpLimits {
   std::size_t max_target = 8192;         // request target bytes; past it 414
+  std::size_t max_field_line = 8192;     // one header line; 431
   std::size_t max_header_bytes = 65536;  // header section bytes after the request line; 431
   std::size_t max_header_fields = 100;   // 431
   std::uint64_t max_body = 65536;        // Content-Length drained; past it 413
@@ -51,9 +52,9 @@ struct HeadParse {
 
 // `buffer` holds what the connection received since the previous request's end. Leading empty
 // lines are skipped (RFC 9112 Sec. 2.2). Lines end in CRLF or a bare LF; a bare CR, a control
-// character, whitespace before a field's colon, a folded line, a second Host or an absolute
-// target is refused (400), as is a version other than HTTP/1.0 and 1.1 (505 for HTTP/2 and
-// later in the request line).
+// character, whitespace before a field's colon, a folded line, a second Host, a target that is
+// neither a path nor http://authority[/path] (nor "*" for OPTIONS) is refused (400), as is a
+// version other than HTTP/1.x (505 for HTTP/2 and later in the request line).
 HeadParse parse_request_head(std::string_view buffer, const HttpLimits& limits);
 
 // How the body after a complete head is framed (RFC 9112 Sec. 6.3, requests).

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -126,6 +127,11 @@ class Routes {
                                     " or localhost:" + port);
     }
     if (req.method != "GET" && req.method != "HEAD") {
+      // RFC 9110 Sec. 15.6.2: 501 for a method the server does not know at all.
+      static const std::set<std::string> known = {"POST",    "PUT",     "DELETE", "PATCH",
+                                                  "OPTIONS", "CONNECT", "TRACE"};
+      if (known.count(req.method) == 0)
+        return text_response(501, req.method + " is not an HTTP method prtr view knows");
       HttpResponse res = text_response(405, req.method + " is not allowed; prtr view answers GET");
       res.headers = {{"Allow", "GET, HEAD"}};
       return res;
