@@ -386,12 +386,21 @@ TEST(HttpServer, SlowClientDoesNotHoldOthers) {
 TEST(HttpServer, IncompleteHeadTimesOutWith408) {
   HttpServerOptions options;
   options.head_timeout = std::chrono::milliseconds(300);
+  options.idle_timeout = std::chrono::milliseconds(600);
   EchoServer server(options);
   const int fd = connect_to(server.port());
   send_all(fd, "GET / HTTP/1.1\r\n");
   const std::string reply = read_to_end(fd);
   ::close(fd);
   EXPECT_EQ(reply.substr(0, 12), "HTTP/1.1 408");
+  // An empty line after a request is not the start of another: the connection is idle and
+  // closes quietly after the idle timeout.
+  const int idle = connect_to(server.port());
+  send_all(idle, get("/a") + "\r\n");
+  const std::vector<Reply> replies = split_replies(read_to_end(idle), {});
+  ::close(idle);
+  ASSERT_EQ(replies.size(), 1u);
+  EXPECT_EQ(replies[0].body, "GET /a");
 }
 
 TEST(HttpServer, StopClosesIdleConnections) {

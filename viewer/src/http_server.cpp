@@ -275,7 +275,8 @@ void HttpServer::serve_connection(int fd) {
     Clock::time_point head_deadline = Clock::now() + options_.head_timeout;
     while (parse.state == HeadParse::State::need_more) {
       if (connection.peer_done() || stopping_) return;  // nothing (more) to answer
-      const bool idle = in.empty();
+      // Empty lines between requests (RFC 9112 Sec. 2.2) do not start a request's head.
+      const bool idle = in.find_first_not_of("\r\n") == std::string::npos;
       const auto deadline =
           std::min(idle ? Clock::now() + options_.idle_timeout : Clock::now() + options_.io_timeout,
                    idle ? Clock::time_point::max() : head_deadline);
