@@ -61,15 +61,24 @@ for kind in diffuse glossy; do
     -o "$dir/seeds/prtc/$kind.prtc" --clusters 2 --pcs 1 --quiet >/dev/null
 done
 
+# HTTP request heads as prtr view receives them: pipelined, with a body, half-sent.
+mkdir -p "$dir/seeds/http"
+printf 'GET /frame?w=64&h=48&client=a&seq=1 HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nAccept: */*\r\n\r\nGET /api/info HTTP/1.1\r\nHost: localhost:8080\r\n\r\n' \
+  >"$dir/seeds/http/pipelined.txt"
+printf 'POST /frame HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nContent-Length: 5\r\nConnection: close\r\n\r\nhello' \
+  >"$dir/seeds/http/body.txt"
+printf '\r\nHEAD / HTTP/1.0\nConnection: keep-alive\nTransfer-Encoding: chunked\n\n' >"$dir/seeds/http/lf.txt"
+printf 'GET /favicon.ico HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nX: a' >"$dir/seeds/http/partial.txt"
+
 declare -A seeds=(
   [fuzz_prtx]=prtx [fuzz_prtx_resealed]=prtx [fuzz_prtc]=prtc [fuzz_prtc_resealed]=prtc
   [fuzz_mesh_obj]=mesh_obj [fuzz_mesh_ply]=mesh_ply [fuzz_mesh_off]=mesh_off
   [fuzz_mesh_stl]=mesh_stl [fuzz_mesh_3ds]=mesh_3ds [fuzz_mesh_gltf]=mesh_gltf [fuzz_mesh_glb]=mesh_glb
-  [fuzz_probe_hdr]=probe_hdr [fuzz_probe_exr]=probe_exr
+  [fuzz_probe_hdr]=probe_hdr [fuzz_probe_exr]=probe_exr [fuzz_http_request]=http
 )
 targets=(fuzz_prtx fuzz_prtx_resealed fuzz_prtc fuzz_prtc_resealed fuzz_mesh_obj fuzz_mesh_ply
          fuzz_mesh_off fuzz_mesh_stl fuzz_mesh_3ds fuzz_mesh_gltf fuzz_mesh_glb fuzz_probe_hdr
-         fuzz_probe_exr)
+         fuzz_probe_exr fuzz_http_request)
 # PRTR_FUZZ_SKIP: targets to leave out (names separated by spaces), e.g. one with an open
 # finding that is being fixed; each is named in the output, so a skip is never silent.
 if [[ -n ${PRTR_FUZZ_SKIP:-} ]]; then

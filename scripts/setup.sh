@@ -33,7 +33,6 @@ packages=(
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
   libassimp-dev  # glTF 2.0 (.gltf, .glb) and 3DS import, meshes/src/read_assimp.cpp
   ffmpeg                # the MP4 of prtr relight (and ffprobe for its test)
-  libcpp-httplib-dev    # prtr view: the HTTP server
   libturbojpeg0-dev     # prtr view: JPEG frames
   glmark2-data blender-data
   fonts-dejavu-core     # prtr overdraw's plots and the picture legends: DejaVu Sans via OpenImageIO

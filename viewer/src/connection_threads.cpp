@@ -1,17 +1,10 @@
 #include "connection_threads.h"
 
-#include <dirent.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <sys/stat.h>
-
-#include <cstdlib>
-#include <string>
-
 namespace viewer::detail {
 
-ConnectionThreads::ConnectionThreads(std::size_t max_threads, std::chrono::milliseconds grace)
-    : max_threads_(max_threads), grace_(grace) {}
+ConnectionThreads::ConnectionThreads(std::size_t max_threads, std::chrono::milliseconds grace,
+                                     std::function<void()> cut_off)
+    : max_threads_(max_threads), grace_(grace), cut_off_(std::move(cut_off)) {}
 
 ConnectionThreads::~ConnectionThreads() {
   shutdown();
@@ -51,39 +44,13 @@ void ConnectionThreads::shutdown() {
   // Answers in progress may finish; connections that only hold a socket open may not.
   if (!idle_.wait_for(lock, grace_, [this] { return busy_ == 0 && waiting_.empty(); })) {
     lock.unlock();
-    shut_down_tcp_connections();
+    cut_off_();
     lock.lock();
   }
   std::vector<std::thread> threads = std::move(threads_);
   threads_.clear();
   lock.unlock();
   for (std::thread& t : threads) t.join();
-}
-
-void shut_down_tcp_connections() {
-  DIR* fds = ::opendir("/proc/self/fd");
-  if (fds == nullptr) return;
-  while (const dirent* entry = ::readdir(fds)) {
-    char* end = nullptr;
-    const long fd = std::strtol(entry->d_name, &end, 10);
-    if (end == entry->d_name || *end != '\0' || fd == ::dirfd(fds)) continue;
-    struct stat st;
-    if (::fstat(int(fd), &st) != 0 || !S_ISSOCK(st.st_mode)) continue;
-    int type = 0, listening = 0;
-    socklen_t size = sizeof type;
-    if (::getsockopt(int(fd), SOL_SOCKET, SO_TYPE, &type, &size) != 0 || type != SOCK_STREAM)
-      continue;
-    size = sizeof listening;
-    if (::getsockopt(int(fd), SOL_SOCKET, SO_ACCEPTCONN, &listening, &size) != 0 || listening)
-      continue;
-    sockaddr_storage address{};
-    size = sizeof address;
-    if (::getsockname(int(fd), reinterpret_cast<sockaddr*>(&address), &size) != 0 ||
-        (address.ss_family != AF_INET && address.ss_family != AF_INET6))
-      continue;
-    ::shutdown(int(fd), SHUT_RDWR);
-  }
-  ::closedir(fds);
 }
 
 }  // namespace viewer::detail

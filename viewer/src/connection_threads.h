@@ -1,17 +1,14 @@
-// viewer/src/connection_threads.h (private): the task queue prtr view gives cpp-httplib, a
-// thread for every open connection up to a cap.
+// viewer/src/connection_threads.h (private): the threads of prtr view's HTTP server
+// (viewer/src/http_server.h), one for every open connection up to a cap.
 //
-// httplib serves a connection on one thread for its whole life (keep-alive included) and
-// bounds each read, not a request's headers as a whole, so a client that sends one header
-// line a second holds its thread for minutes. With httplib's fixed pool of 16, 16 such
-// clients locked every other client out, and SIGTERM waited for them. Here every connection
-// gets a thread while fewer than the cap are open (past it, new connections wait for one), so
-// slow clients hold only their own threads. When the server stops, open connections get a
-// short grace period to finish their answer; then their sockets are shut down, which ends
-// the blocked reads, and the threads are joined.
+// A connection is served on one thread for its whole life (keep-alive included), so with a
+// fixed pool of 16 (cpp-httplib's, before), 16 clients sending one header line a second
+// locked every other client out, and SIGTERM waited for them. Here every connection gets a
+// thread while fewer than the cap are open (past it, new connections wait for one), so slow
+// clients hold only their own threads. When the server stops, open connections get a short
+// grace period to finish their answer; then `cut_off` runs (the server shuts their sockets
+// down, which ends blocked reads and writes) and the threads are joined.
 #pragma once
-
-#include <httplib.h>
 
 #include <chrono>
 #include <condition_variable>
@@ -24,19 +21,24 @@
 
 namespace viewer::detail {
 
-class ConnectionThreads : public httplib::TaskQueue {
+class ConnectionThreads {
  public:
-  ConnectionThreads(std::size_t max_threads, std::chrono::milliseconds grace);
-  ~ConnectionThreads() override;
+  ConnectionThreads(std::size_t max_threads, std::chrono::milliseconds grace,
+                    std::function<void()> cut_off);
+  ~ConnectionThreads();
+  ConnectionThreads(const ConnectionThreads&) = delete;
+  ConnectionThreads& operator=(const ConnectionThreads&) = delete;
 
-  void enqueue(std::function<void()> connection) override;
-  void shutdown() override;
+  void enqueue(std::function<void()> connection);
+  // Serves what is waiting, waits up to the grace period, cuts off, joins. Idempotent.
+  void shutdown();
 
  private:
   void work();
 
   const std::size_t max_threads_;
   const std::chrono::milliseconds grace_;
+  const std::function<void()> cut_off_;
   std::mutex mutex_;
   std::condition_variable wake_;  // a connection waits, or stopping
   std::condition_variable idle_;  // a connection ended
@@ -46,9 +48,5 @@ class ConnectionThreads : public httplib::TaskQueue {
   std::size_t busy_ = 0;
   bool stopping_ = false;
 };
-
-// Shuts down (both directions) every connected TCP socket of this process, so that threads
-// blocked reading from them return. prtr view has no other TCP connections.
-void shut_down_tcp_connections();
 
 }  // namespace viewer::detail

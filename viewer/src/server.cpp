@@ -1,19 +1,15 @@
 #include "viewer/server.h"
 
-#include "connection_threads.h"
-
+#include "http_server.h"
 #include "page.h"
 #include "viewer/encode.h"
 #include "viewer/queue.h"
 
-#include <httplib.h>
-
-#include <sys/socket.h>
 #include <unistd.h>
-#include <atomic>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -66,17 +62,14 @@ class StopSignals {
   }, old_term_{};
 };
 
-void send_frame(const FramePtr& frame, httplib::Response& res) {
-  if (!frame->request_error.empty()) {
-    res.status = 400;
-    res.set_content(frame->request_error + "\n", "text/plain");
-    return;
-  }
-  if (!frame->server_error.empty()) {
-    res.status = 500;
-    res.set_content("rendering failed: " + frame->server_error + "\n", "text/plain");
-    return;
-  }
+using detail::HttpHead;
+using detail::HttpResponse;
+using detail::text_response;
+
+HttpResponse frame_response(const FramePtr& frame) {
+  if (!frame->request_error.empty()) return text_response(400, frame->request_error);
+  if (!frame->server_error.empty())
+    return text_response(500, "rendering failed: " + frame->server_error);
   std::call_once(frame->encoded, [&] {
     const auto start = Clock::now();
     std::vector<std::uint8_t> rgb = render::tone_map_rgb8(frame->image, frame->state.exposure);
@@ -86,30 +79,24 @@ void send_frame(const FramePtr& frame, httplib::Response& res) {
     frame->jpeg = encode_jpeg(rgb, frame->image.width, frame->image.height);
     frame->encode_ms = elapsed_ms(start);
   });
-  res.set_header("Cache-Control", "no-store");
-  res.set_header("X-Prtr-Frame", dump_json(frame_header(*frame)));
-  res.set_content(std::string(frame->jpeg.begin(), frame->jpeg.end()), "image/jpeg");
+  HttpResponse res;
+  res.content_type = "image/jpeg";
+  res.body.assign(frame->jpeg.begin(), frame->jpeg.end());
+  res.headers = {{"Cache-Control", "no-store"}, {"X-Prtr-Frame", dump_json(frame_header(*frame))}};
+  return res;
 }
 
-void handle_frame(FrameQueue& queue, const ServedInfo& served, const httplib::Request& req,
-                  httplib::Response& res) {
+HttpResponse handle_frame(FrameQueue& queue, const ServedInfo& served, const std::string& query) {
   ViewState state;
   try {
-    // The raw query, not httplib's lenient parse (which keeps `w=abc=480` as w=480 and splits
-    // on ';').
-    const std::size_t mark = req.target.find('?');
-    const std::string raw = mark == std::string::npos ? "" : req.target.substr(mark + 1);
-    state = parse_view_request(parse_query(raw), served.limits, served.defaults);
+    state = parse_view_request(parse_query(query), served.limits, served.defaults);
   } catch (const RequestError& e) {
-    res.status = 400;
-    res.set_content(std::string(e.what()) + "\n", "text/plain");
-    return;
+    return text_response(400, e.what());
   }
   try {
-    send_frame(queue.submit(state).get(), res);
+    return frame_response(queue.submit(state).get());
   } catch (const QueueRefused& e) {
-    res.status = 503;
-    res.set_content(std::string(e.what()) + "\n", "text/plain");
+    return text_response(503, e.what());
   }
 }
 
@@ -124,63 +111,60 @@ bool allowed_host(const std::string& host_header, const ServerOptions& options, 
   return name == options.host || name == "localhost";
 }
 
-void refuse(httplib::Response& res, int status, const std::string& why) {
-  res.status = status;
-  res.set_content(why + "\n", "text/plain");
-}
+// The routes, read-only: every path answers GET and HEAD, other methods 405.
+class Routes {
+ public:
+  Routes(FrameQueue& queue, const ServedInfo& served, const ServerOptions& options)
+      : queue_(queue), served_(served), options_(options), info_(dump_json(served.info)) {}
+  void set_port(int port) { port_ = port; }
 
-void add_routes(httplib::Server& server, FrameQueue& queue, const ServedInfo& served) {
-  server.Get("/", [](const httplib::Request&, httplib::Response& res) {
-    res.set_content(view_page_html(), "text/html; charset=utf-8");
-  });
-  // Browsers ask for it on every page load; no icon, and no 404 in their console.
-  server.Get("/favicon.ico",
-             [](const httplib::Request&, httplib::Response& res) { res.status = 204; });
-  const std::string info = dump_json(served.info);
-  server.Get("/api/info", [info](const httplib::Request&, httplib::Response& res) {
-    res.set_content(info, "application/json");
-  });
-  server.Get("/frame", [&queue, &served](const httplib::Request& req, httplib::Response& res) {
-    handle_frame(queue, served, req, res);
-  });
-  // Every path is read-only: other methods are 405 (httplib would answer 404).
-  const auto not_allowed = [](const httplib::Request& req, httplib::Response& res) {
-    res.set_header("Allow", "GET, HEAD");
-    refuse(res, 405, req.method + " is not allowed; prtr view answers GET");
-  };
-  server.Post(".*", not_allowed);
-  server.Put(".*", not_allowed);
-  server.Patch(".*", not_allowed);
-  server.Delete(".*", not_allowed);
-  server.Options(".*", not_allowed);
-  server.set_error_handler([](const httplib::Request&, httplib::Response& res) {
-    if (res.body.empty())
-      res.set_content(res.status == 404 ? "not found\n" : "bad request\n", "text/plain");
-  });
-  server.set_exception_handler(
-      [](const httplib::Request&, httplib::Response& res, std::exception_ptr ep) {
-        res.status = 500;
-        try {
-          std::rethrow_exception(ep);
-        } catch (const std::exception& e) {
-          res.set_content(std::string("internal error: ") + e.what() + "\n", "text/plain");
-        } catch (...) {
-          res.set_content("internal error\n", "text/plain");
-        }
-      });
-}
+  HttpResponse operator()(const HttpHead& req) const {
+    const std::string* host = req.field("host");
+    if (host == nullptr || !allowed_host(*host, options_, port_)) {
+      const std::string port = std::to_string(port_);
+      return text_response(421, "Host '" + (host ? *host : std::string()) +
+                                    "' is not this server; use " + options_.host + ":" + port +
+                                    " or localhost:" + port);
+    }
+    if (req.method != "GET" && req.method != "HEAD") {
+      // RFC 9110 Sec. 15.6.2: 501 for a method the server does not know at all.
+      static const std::set<std::string> known = {"POST",    "PUT",     "DELETE", "PATCH",
+                                                  "OPTIONS", "CONNECT", "TRACE"};
+      if (known.count(req.method) == 0)
+        return text_response(501, req.method + " is not an HTTP method prtr view knows");
+      HttpResponse res = text_response(405, req.method + " is not allowed; prtr view answers GET");
+      res.headers = {{"Allow", "GET, HEAD"}};
+      return res;
+    }
+    // The raw query, split here and parsed strictly by parse_query.
+    const std::size_t mark = req.target.find('?');
+    const std::string path = req.target.substr(0, mark);
+    const std::string query = mark == std::string::npos ? "" : req.target.substr(mark + 1);
+    if (path == "/") {
+      HttpResponse res;
+      res.content_type = "text/html; charset=utf-8";
+      res.body = view_page_html();
+      return res;
+    }
+    if (path == "/api/info") {
+      HttpResponse res;
+      res.content_type = "application/json";
+      res.body = info_;
+      return res;
+    }
+    if (path == "/frame") return handle_frame(queue_, served_, query);
+    // Browsers ask for it on every page load; no icon, and no 404 in their console.
+    if (path == "/favicon.ico") return HttpResponse{204, {}, {}, {}};
+    return text_response(404, "not found");
+  }
 
-int bind(httplib::Server& server, const ServerOptions& options) {
-  const int port = options.port == 0
-                       ? server.bind_to_any_port(options.host)
-                       : (server.bind_to_port(options.host, options.port) ? options.port : -1);
-  if (port <= 0)
-    throw std::runtime_error("prtr view: cannot listen on " + options.host + ":" +
-                             std::to_string(options.port) +
-                             " (in use, or not an address of this machine); choose another "
-                             "--port or --host");
-  return port;
-}
+ private:
+  FrameQueue& queue_;
+  const ServedInfo& served_;
+  const ServerOptions& options_;
+  const std::string info_;
+  int port_ = 0;
+};
 
 // The render loop: one job at a time until the queue stops.
 void render_jobs(ViewScene& scene, FrameQueue& queue) {
@@ -237,53 +221,27 @@ Json frame_header(const RenderedFrame& f) {
 
 void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions& options) {
   FrameQueue queue;
-  httplib::Server server;
-  const auto connections = std::size_t(options.max_connections);
-  server.new_task_queue = [connections] {
-    return new detail::ConnectionThreads(connections, std::chrono::milliseconds(500));
-  };
-  // Headers and body go out in separate writes: with Nagle's algorithm the body waits for
-  // the client's delayed ACK (~40 ms on Linux), longer than a small frame takes to render.
-  server.set_tcp_nodelay(true);
-  // SO_REUSEADDR only (a restart need not wait out TIME_WAIT). httplib's default adds
-  // SO_REUSEPORT, with which a second viewer binds the same port and takes half the requests.
-  server.set_socket_options([](socket_t sock) {
-    int yes = 1;
-    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-  });
-  add_routes(server, queue, served);
-  const int port = bind(server, options);
-  server.set_pre_routing_handler([&options, port](const httplib::Request& req,
-                                                  httplib::Response& res) {
-    if (allowed_host(req.get_header_value("Host"), options, port))
-      return httplib::Server::HandlerResponse::Unhandled;
-    refuse(res, 421,
-           "Host '" + req.get_header_value("Host") + "' is not this server; use " + options.host +
-               ":" + std::to_string(port) + " or localhost:" + std::to_string(port));
-    return httplib::Server::HandlerResponse::Handled;
-  });
+  Routes routes(queue, served, options);
+  detail::HttpServerOptions http;
+  http.host = options.host;
+  http.port = options.port;
+  http.max_connections = std::size_t(options.max_connections);
+  detail::HttpServer server(http, [&routes](const HttpHead& req) { return routes(req); });
+  routes.set_port(server.port());
   StopSignals signals;
-  std::printf("prtr view: http://%s:%d/\n", options.host.c_str(), port);
+  std::printf("prtr view: http://%s:%d/\n", options.host.c_str(), server.port());
   std::fflush(stdout);
-  std::atomic<bool> listening_ended{false};
-  std::thread http([&] {
-    server.listen_after_bind();
-    listening_ended = true;
-  });
+  std::thread connections([&] { server.serve(); });
   std::thread watcher([&] {
     signals.wait();
     queue.stop();
     server.stop();
   });
   render_jobs(scene, queue);
-  // stop() does nothing before listening has begun, so repeat it until the loop has ended.
-  while (!listening_ended) {
-    server.stop();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  server.stop();
   signals.wake();  // the watcher, when the loop ended without a signal
   watcher.join();
-  http.join();
+  connections.join();
   const FrameQueue::Counters c = queue.counters();
   std::printf("prtr view: stopped after %llu frame requests (%llu coalesced)\n",
               static_cast<unsigned long long>(c.requests),

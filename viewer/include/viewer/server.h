@@ -1,12 +1,14 @@
-// viewer/server.h: the HTTP side of `prtr view` (cpp-httplib, only in
-// view_server.cpp). Routes: GET / (the page), GET /api/info (what does not change, JSON),
+// viewer/server.h: the HTTP side of `prtr view` (its own HTTP/1.1 server in
+// viewer/src/http_server.h: keep-alive, pipelined requests answered in order, half-closed
+// requests answered). Routes: GET / (the page), GET /api/info (what does not change, JSON),
 // GET /frame?... (a JPEG of the state the query describes, viewer/request.h; its statistics in
-// the X-Prtr-Frame header as JSON), GET /favicon.ico (204). Anything else is 404, another
-// method 405, a Host other than the listening address or localhost 421 (DNS rebinding); a bad
-// query is 400 with a one-line reason (viewer/request.h, parsed from the raw query); 503
-// while stopping. The port is bound exclusively: a second viewer on it fails to start. Request
-// threads parse, queue (viewer/queue.h), wait and encode; the calling thread renders, since the GL
-// context is current there.
+// the X-Prtr-Frame header as JSON), GET /favicon.ico (204); HEAD on each. Anything else is
+// 404, another method 405 (501 for one HTTP does not define), a Host other than the listening
+// address or localhost 421 (DNS rebinding); a bad query is 400 with a one-line reason
+// (viewer/request.h, parsed from the raw query); 503 while stopping. The port is bound
+// exclusively: a second viewer on it fails to start. Request threads parse, queue
+// (viewer/queue.h), wait and encode; the calling thread renders, since the GL context is
+// current there.
 #pragma once
 
 #include "common/json.h"
