@@ -11,6 +11,10 @@
 #include "view_flags.h"
 
 #include "cpca/compressed_file.h"
+#include "meshes/atlas.h"
+#include "pipeline/slf_file.h"
+#include "render/slf_from_compressed.h"
+#include "render/slf_renderer.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
 #include "probes/load.h"
@@ -23,7 +27,9 @@
 #include "render/renderer.h"
 #include "render/supersample.h"
 
+#include <algorithm>
 #include <chrono>
+#include <fstream>
 #include <cstdio>
 #include <memory>
 #include <numbers>
@@ -57,7 +63,7 @@ struct Options {
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
-  cmd->add_option("COMPRESSED", o.compressed, "Compressed transfer file (.prtc)")->required();
+  cmd->add_option("COMPRESSED", o.compressed, "Compressed transfer (.prtc) or surface light field (.slfc)")->required();
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("-o,--output", o.output, "EXR to write (linear RGB, alpha = coverage)")
       ->required();
@@ -213,11 +219,96 @@ void print_report(const Options& o, const render::RenderStats& st,
   }
 }
 
+// A compressed surface light field (.slfc) rather than a PRT set: its first bytes say so.
+bool is_slfc(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[8] = {};
+  return in.read(magic, sizeof magic) && std::string(magic, sizeof magic) == "PRTRSLFC";
+}
+
+// prtr render SET.slfc: the surface light field seen from the camera in one pass. Its
+// lighting is baked, so only the camera moves; the probe is the background and must be the
+// one it was baked under.
+void run_slf(const Options& o, CLI::App* cmd) {
+  for (const char* flag : {"--mode", "--transfer", "--rotate-deg", "--spin-deg",
+                           "--register-budget", "--clusters-per-pass", "--strategy",
+                           "--accumulation", "--constants"})
+    if (cmd->count(flag))
+      throw UsageError(std::string(flag) + " applies to PRT sets (.prtc); " + o.compressed +
+                       " is a surface light field, whose lighting is baked and which renders "
+                       "in one pass");
+  const render::GlSelection gl = gl_selection(o.gl);
+  const pipeline::CompressedSlf slf = pipeline::read_slfc(o.compressed);
+  if (!slf.complete())
+    throw std::runtime_error(o.compressed + " holds only rows " +
+                             std::to_string(slf.bake.first_row) + " to " +
+                             std::to_string(slf.bake.first_row + slf.bake.row_count) + " of " +
+                             std::to_string(slf.bake.rows) +
+                             " (a measurement made with --rows); make it without --rows");
+  const std::string mesh_path = o.mesh.empty() ? slf.mesh_path : o.mesh;
+  const meshes::Mesh mesh = meshes::load_mesh(mesh_path, load_options(o.mesh_flags));
+  if (meshes::content_hash(mesh) != slf.bake.mesh_hash)
+    throw std::runtime_error(o.compressed + " was made from a different mesh than " + mesh_path +
+                             " (stale); make it again, or pass the right --mesh (and the "
+                             "--crease-angle it was made with)");
+  const probes::Probe probe = probes::load_probe(o.probe);
+  if (prt::probe_hash(probe) != slf.bake.probe_hash)
+    throw UsageError("--probe: " + o.compressed + " was baked under " + slf.probe_name +
+                     ", not " + o.probe + "; a surface light field's lighting is fixed, so "
+                     "pass the probe it was made with");
+  const meshes::Atlas atlas =
+      meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height);
+  const render::SlfModel model =
+      render::slf_model_from_compressed(mesh, atlas, slf.bake.grid, slf.set);
+  const render::Background background = resolve_background(o.view);
+  const render::Camera camera = resolve_camera(o.view, mesh);
+
+  render::GlContext context(gl);
+  render::SlfRendererOptions ro;
+  ro.cull_back_faces = !o.no_cull;
+  render::SlfRenderer renderer(model, &probe, ro);
+  renderer.set_background(background);
+  for (int i = 0; i < o.warmup; ++i) renderer.render(camera);
+  std::vector<double> frame_ms;
+  for (int i = 0; i < o.frames; ++i) frame_ms.push_back(renderer.render(camera).total_ms);
+  std::sort(frame_ms.begin(), frame_ms.end());
+  const double median = frame_ms.empty() ? 0.0 : frame_ms[frame_ms.size() / 2];
+  const double image_ms = renderer.render(render::supersampled(camera, o.supersample)).total_ms;
+  const render::Image image = render::box_downsample(renderer.read_image(), o.supersample);
+  render::write_exr(o.output, image);
+  if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
+  if (!o.quiet) {
+    std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
+                o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
+    std::printf("slf         one pass, %d cluster(s), %d PCA term(s), %d x %d texels, %d x %d "
+                "directions, baked under %s\n",
+                model.clusters, model.components, model.map_width, model.map_height,
+                model.grid.azimuth, model.grid.elevation, slf.probe_name.c_str());
+    std::printf("timing      %.2f FPS: frame %.2f ms median over %d frames\n",
+                median > 0 ? 1000.0 / median : 0.0, median, o.frames);
+    std::printf("image       %d x %d samples per pixel, %.2f ms for the written frame\n",
+                o.supersample, o.supersample, image_ms);
+  }
+  if (o.json)
+    std::printf("%s\n", dump_json(Json{{"mode", "slf"},
+                                       {"width", o.view.width},
+                                       {"height", o.view.height},
+                                       {"passes", 1},
+                                       {"clusters", model.clusters},
+                                       {"components", model.components},
+                                       {"fps", median > 0 ? 1000.0 / median : 0.0},
+                                       {"frame_ms_median", median},
+                                       {"supersample", o.supersample},
+                                       {"image_frame_ms", image_ms}})
+                            .c_str());
+}
+
 void run(const Options& o, CLI::App* cmd) {
   check_outputs({{"-o", o.output}, {"--png", o.png}}, {{"COMPRESSED", o.compressed},
                                                        {"--probe", o.probe},
                                                        {"--mesh", o.mesh},
                                                        {"--transfer", o.transfer}});
+  if (is_slfc(o.compressed)) return run_slf(o, cmd);
   const render::GlSelection gl = gl_selection(o.gl);
   render::RendererOptions ro = renderer_options(o, cmd);
   const render::Background background = resolve_background(o.view);
@@ -270,7 +361,8 @@ void run(const Options& o, CLI::App* cmd) {
 }
 
 constexpr const char* kAbout =
-    "Relight a compressed bake (.prtc) under a rotated probe; write EXR/PNG and FPS";
+    "Relight a compressed bake (.prtc) under a rotated probe, or show a surface light field "
+    "(.slfc); write EXR/PNG and FPS";
 
 }  // namespace cmd_render
 

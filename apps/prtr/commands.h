@@ -36,6 +36,7 @@ Runner add_merge_command(CLI::App& app);
 Runner add_view_command(CLI::App& app);
 Runner add_slf_command(CLI::App& app);
 Runner add_path_trace_command(CLI::App& app);
+Runner add_compare_command(CLI::App& app);
 
 // A usage error found after parsing (e.g. flags that contradict each other): exit code 2.
 class UsageError : public std::runtime_error {

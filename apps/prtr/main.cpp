@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   add(prtr_app::add_view_command);
   add(prtr_app::add_slf_command);
   add(prtr_app::add_path_trace_command);
+  add(prtr_app::add_compare_command);
   add(prtr_app::add_info_command);
   add(prtr_app::add_gl_info_command);
 
