@@ -41,6 +41,15 @@ struct JointSearchOptions {
   // may only come down). A constraint, not a weight: with a small lambda the search spends
   // the overdraw budget on error, and J still never rises.
   double overdraw_cap = 0.0;
+  // > 0: the epsilon-constraint search (Haimes, Lasdon & Wismer 1971) instead: minimise the
+  // triangles drawn subject to Average SE <= error_target. lambda and overdraw_cap are then
+  // unused: the price of a drawn triangle is a multiplier the search adapts (halved while the
+  // error is above the target, doubled while a feasible step cuts nothing). Its moves are
+  // bounded: a vertex considers only the clusters of its pass and of its 1-ring, and the
+  // refits start from the previous bases (refit_tolerance). Stops after max_steps or 3
+  // rejected steps in a row.
+  double error_target = 0.0;
+  double refit_tolerance = 1e-8;
 };
 
 struct JointSearchResult {
