@@ -203,6 +203,26 @@ ClusterIncidence incidence_of(const CompressedSet& set, const Geometry& g, int p
   return cluster_incidence(input);
 }
 
+// Each vertex's squared error under its cluster's stored mean, basis and weights, as
+// fit_cluster_pca reports it.
+std::vector<double> reconstruction_errors(const Eigen::Ref<const DataMatrix>& data,
+                                          const CompressedSet& set) {
+  std::vector<double> error(set.cluster_of.size());
+  const Eigen::Index n = set.component_count;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, error.size(), 256), [&](const auto& range) {
+    for (std::size_t p = range.begin(); p < range.end(); ++p) {
+      const int c = int(set.cluster_of[p]);
+      Eigen::RowVectorXd r = (data.row(Eigen::Index(p)) - set.mean(c)).template cast<double>();
+      if (n > 0)
+        r -= Eigen::Map<const Eigen::RowVectorXf>(set.weights.data() + p * std::size_t(n), n)
+                 .cast<double>() *
+             set.basis(c).template cast<double>();
+      error[p] = r.squaredNorm();
+    }
+  });
+  return error;
+}
+
 // One step from (set, error, pass_of); returns false (and leaves them) unless J fell.
 bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const VertexTriangles& vt,
           const Eigen::VectorXf& norms, const JointSearchOptions& o, double mu, CompressedSet& set,
@@ -252,10 +272,11 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
 }
 
 // The epsilon search's candidates: for every vertex its own cluster (first), the other
-// clusters of its pass (a move among them costs no draws) and the clusters of its 1-ring
-// (the only moves that can change draws), each with its squared distance to that cluster's
-// affine subspace under the step's bases. Bounded by per_pass + the 1-ring's clusters, so a
-// step costs O(V (per_pass + ring)) distances instead of iterative CPCA's V x K mean products.
+// clusters of its pass (a move among them costs no draws), the clusters of its 1-ring (the
+// only moves that can change draws) and, when `near` is given, the finite entries of its row
+// (the nearest means), each with its squared distance to that cluster's affine subspace under
+// the step's bases. Without `near` a step costs O(V (per_pass + ring)) distances instead of
+// iterative CPCA's V x K mean products.
 struct Candidates {
   std::vector<std::uint32_t> offset, cluster;
   std::vector<double> error;
@@ -263,7 +284,7 @@ struct Candidates {
 
 Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set,
                               const Geometry& g, const VertexTriangles& vt,
-                              const std::vector<std::uint32_t>& pass_of, const DataMatrix& near) {
+                              const std::vector<std::uint32_t>& pass_of, const DataMatrix* near) {
   const std::size_t vertices = set.cluster_of.size();
   std::vector<std::vector<std::uint32_t>> in_pass(
       std::size_t(*std::max_element(pass_of.begin(), pass_of.end())) + 1);
@@ -278,54 +299,89 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
         const std::uint32_t c = set.cluster_of[v];
         if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
       }
-    const auto row = near.row(Eigen::Index(p));
+    if (!near) return;
+    const auto row = near->row(Eigen::Index(p));
     for (Eigen::Index c = 0; c < row.size(); ++c)
       if (std::isfinite(row[c]) && std::find(out.begin(), out.end(), std::uint32_t(c)) == out.end())
         out.push_back(std::uint32_t(c));
   };
+  std::vector<std::vector<std::uint32_t>> lists(vertices);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, 512), [&](const auto& range) {
+    for (std::size_t p = range.begin(); p < range.end(); ++p) list(std::uint32_t(p), lists[p]);
+  });
   Candidates r;
   r.offset.assign(vertices + 1, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, 512), [&](const auto& range) {
-    std::vector<std::uint32_t> out;
-    for (std::size_t p = range.begin(); p < range.end(); ++p) {
-      list(std::uint32_t(p), out);
-      r.offset[p + 1] = std::uint32_t(out.size());
-    }
-  });
-  for (std::size_t p = 0; p < vertices; ++p) r.offset[p + 1] += r.offset[p];
+  for (std::size_t p = 0; p < vertices; ++p)
+    r.offset[p + 1] = r.offset[p] + std::uint32_t(lists[p].size());
   r.cluster.resize(r.offset.back());
   r.error.resize(r.offset.back());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, 256), [&](const auto& range) {
-    std::vector<std::uint32_t> out;
-    for (std::size_t p = range.begin(); p < range.end(); ++p) {
-      list(std::uint32_t(p), out);
-      for (std::size_t i = 0; i < out.size(); ++i) {
-        r.cluster[r.offset[p] + i] = out[i];
-        r.error[r.offset[p] + i] = subspace_distance(data.row(Eigen::Index(p)), set, int(out[i]));
-      }
+  // Each cluster's candidate points in one matrix product (as subspace_distances does): one
+  // (point, cluster) pair at a time cost half the search's time.
+  std::vector<std::vector<std::uint32_t>> entries(std::size_t(set.cluster_count));
+  std::vector<std::uint32_t> point_of(r.offset.back());
+  for (std::uint32_t p = 0; p < vertices; ++p)
+    for (std::uint32_t i = 0; i < lists[p].size(); ++i) {
+      r.cluster[r.offset[p] + i] = lists[p][i];
+      point_of[r.offset[p] + i] = p;
+      entries[lists[p][i]].push_back(r.offset[p] + i);
     }
+  const Eigen::Index d = data.cols();
+  tbb::parallel_for(0, set.cluster_count, [&](int c) {
+    const std::vector<std::uint32_t>& e = entries[std::size_t(c)];
+    if (e.empty()) return;
+    const Eigen::Map<const Eigen::RowVectorXf> mean(
+        set.means.data() + std::size_t(c) * std::size_t(d), d);
+    DataMatrix centred(Eigen::Index(e.size()), d);
+    for (std::size_t i = 0; i < e.size(); ++i)
+      centred.row(Eigen::Index(i)) = data.row(point_of[e[i]]) - mean;
+    Eigen::VectorXf residual = centred.rowwise().squaredNorm();
+    if (set.component_count > 0)
+      residual -= (centred * set.basis(c).transpose()).rowwise().squaredNorm();
+    for (std::size_t i = 0; i < e.size(); ++i)
+      r.error[e[i]] = std::max(0.0, double(residual[Eigen::Index(i)]));
   });
   return r;
 }
 
 // Gauss-Seidel moves minimising err + mu * draws among the bounded candidates, with the
 // step's bases fixed, under the error constraint: the running total of the members' errors
-// (under those bases) never exceeds the cap; a sweep that starts above it takes only moves
-// that lower the error. The refit that follows can only lower each
-// cluster's error for its new members, so a step that ends within the limit stays within it.
+// (under those bases) never exceeds the cap, and while it is above the cap only moves that
+// lower the error are taken. The refit that follows can only lower each cluster's error for
+// its new members, so a step that ends within the cap stays within it.
 std::int64_t sweep_epsilon(const Candidates& cand, SweepState& s, double cap,
                            std::uint64_t& moves) {
+  const std::uint32_t vertices = std::uint32_t(s.cluster_of.size());
   double total = 0;
-  for (std::size_t p = 0; p < s.cluster_of.size(); ++p) total += cand.error[cand.offset[p]];
-  // Above the cap every move must lower the error: draws are then only the tie-breaker the
-  // price makes them, so the search cannot trade error it must lose for draws.
-  const bool above = total > cap;
+  for (std::uint32_t p = 0; p < vertices; ++p) total += cand.error[cand.offset[p]];
+  // Vertices in order of their best move's gain (err + mu * draws) at the sweep's start, so
+  // the error allowance goes to the cheapest draws first instead of to the lowest indices.
+  std::vector<double> gain(vertices, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, vertices, 512), [&](const auto& range) {
+    for (std::uint32_t p = range.begin(); p < range.end(); ++p) {
+      const std::uint32_t a = s.cluster_of[p];
+      const std::int64_t here = s.draws(p, s.pass_of[a]);
+      for (std::uint32_t i = cand.offset[p] + 1; i < cand.offset[p + 1]; ++i) {
+        const std::uint32_t c = cand.cluster[i];
+        const std::int64_t n = s.pass_of[c] == s.pass_of[a] ? here : s.draws(p, s.pass_of[c]);
+        gain[p] =
+            std::min(gain[p], cand.error[i] - cand.error[cand.offset[p]] + s.mu * double(n - here));
+      }
+    }
+  });
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t p = 0; p < vertices; ++p)
+    if (gain[p] < 0) order.push_back(p);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return gain[a] < gain[b]; });
   std::int64_t saved = 0;
-  for (std::uint32_t p = 0; p < s.cluster_of.size(); ++p) {
+  for (const std::uint32_t p : order) {
     const std::uint32_t a = s.cluster_of[p];
     if (s.size[a] <= 1) continue;
     const std::int64_t here = s.draws(p, s.pass_of[a]);
     const double own = cand.error[cand.offset[p]];
+    // Above the cap every move must lower the error (draws are then only the tie-breaker the
+    // price makes them); within it no move may take the running total above it.
+    const bool above = total > cap;
     double best = 0, best_de = 0;
     std::uint32_t best_c = a;
     std::int64_t best_draws = here;
@@ -356,8 +412,12 @@ bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
                   const JointSearchOptions& o, double mu, double cap_total, CompressedSet& set,
                   std::vector<double>& error, std::vector<std::uint32_t>& pass_of,
                   JointSearchResult& r, bool& feasible) {
-  const Candidates cand = bounded_candidates(data, set, g, vt, pass_of,
-                                             subspace_distances(data, norms, set, o.candidates));
+  // Above the cap the search needs error-lowering moves, which the nearest means offer (as
+  // in iterative CPCA); within it only moves that change draws matter, and those are bounded
+  // to the 1-ring, so the V x K distance products are skipped.
+  const bool above = total_of(error) > cap_total;
+  const DataMatrix near = above ? subspace_distances(data, norms, set, o.candidates) : DataMatrix();
+  const Candidates cand = bounded_candidates(data, set, g, vt, pass_of, above ? &near : nullptr);
   CompressedSet next = set;
   std::vector<std::uint32_t> next_pass = pass_of;
   std::uint64_t moves = 0, swaps = 0;
@@ -426,7 +486,12 @@ CompressedSet joint_start(const Eigen::Ref<const DataMatrix>& data, const Compre
   // patch-first, a fit of the same clusters over the whole data).
   PowerIterationOptions power;
   power.seed = options.seed;
-  error = fit_cluster_pca(data, set, options.solver, power);
+  if (options.method == ClusterMethod::kPatchEpsilon)
+    // The stitched patches already hold each cluster's fit of its members: only the errors
+    // are missing, and a second fit of every cluster would cost as much as the start.
+    error = reconstruction_errors(data, set);
+  else
+    error = fit_cluster_pca(data, set, options.solver, power);
   if (patches) {
     pass_of.resize(std::size_t(set.cluster_count));
     for (std::uint32_t c = 0; c < pass_of.size(); ++c)
@@ -511,13 +576,23 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
     for (int i = 1, rejected = 0; i <= options.max_steps && rejected < 3; ++i) {
       r.tried = i;
       bool feasible = false;
+      const double error_before = total_of(vertex_error);
+      const std::uint64_t drawn_before = r.triangles_drawn;
       const bool kept = epsilon_step(data, geometry, vt, norms, options, price, cap_total, set,
                                      vertex_error, pass_of, r, feasible);
-      rejected = kept ? 0 : rejected + 1;
+      // A kept step that moved neither draws nor error by the threshold counts as a stall.
+      const bool moved =
+          kept &&
+          (double(drawn_before - r.triangles_drawn) >= options.threshold * double(drawn_before) ||
+           error_before - total_of(vertex_error) >= options.threshold * error_before);
+      rejected = moved ? 0 : rejected + 1;
+      // Dual ascent on the constraint: a draw gets cheaper while the error is above the cap
+      // and dearer (faster: the allowance is spent in few steps) while more than 1% of it is
+      // left unspent.
       if (!feasible)
         price *= 0.5;
-      else if (!kept)
-        price *= 2;
+      else if (total_of(vertex_error) < 0.99 * cap_total || !kept)
+        price *= 4;
     }
     r.pass_of = std::move(pass_of);
     return r;
