@@ -15,13 +15,14 @@
 #
 # Usage: scripts/overdraw_experiments.sh [OUT_DIR]   (default out/experiments)
 # Knobs (environment): RUNS (bunny cat horse asteroid: a subset re-runs only those), CLUSTERS
-# (128,256), ROWS, STRATEGIES (ils), ROUNDS (1), FRAMES (1), WIDTH (640), HEIGHT (474), CACHE
+# (128,256), ROWS, STRATEGIES (ils), ROUNDS (1), FRAMES (1), WIDTH (640), HEIGHT (474), PRTR
+# (./build/prtr; a copy keeps a rebuild from replacing the binary mid-run), CACHE
 # (out/cache), NICE (10). Bakes and compressions are cached, so a second
 # run only re-times. Writes OUT_DIR/<run>.md (the tables), OUT_DIR/<run>/ (CSV, JSON, plots)
 # and OUT_DIR/summary.md (scripts/overdraw_summary.py's condensed tables, then the full ones).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-prtr=./build/prtr
+prtr=${PRTR:-./build/prtr}
 out=${1:-out/experiments}
 probe=/usr/share/blender/datafiles/studiolights/world/forest.exr
 models=/usr/share/glmark2/models

@@ -568,8 +568,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
   const Eigen::VectorXf norms = data.rowwise().squaredNorm();
   if (options.error_target > 0) {
     // The epsilon-constraint search: the price of a drawn triangle is a Lagrange multiplier
-    // found by the search itself (halved while the error is above the cap, doubled while a
-    // feasible step finds nothing to cut), so no weight needs setting per mesh or K.
+    // found by the search itself (below), so no weight needs setting per mesh or K.
     const double cap_total = options.error_target * double(data.rows());
     double price = 2 * total / t;
     r.triangles_drawn = swap_descent(inc, options.per_pass, pass_of, r.pass_swaps);
@@ -582,9 +581,9 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
                                      vertex_error, pass_of, r, feasible);
       // A kept step that moved neither draws nor error by the threshold counts as a stall.
       const bool moved =
-          kept &&
-          (double(drawn_before - r.triangles_drawn) >= options.threshold * double(drawn_before) ||
-           error_before - total_of(vertex_error) >= options.threshold * error_before);
+          kept && (double(drawn_before) - double(r.triangles_drawn) >=
+                       options.threshold * double(drawn_before) ||
+                   error_before - total_of(vertex_error) >= options.threshold * error_before);
       rejected = moved ? 0 : rejected + 1;
       // Dual ascent on the constraint: a draw gets cheaper while the error is above the cap
       // and dearer (faster: the allowance is spent in few steps) while more than 1% of it is
