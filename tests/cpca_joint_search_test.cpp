@@ -212,6 +212,28 @@ TEST(EpsilonSearch, MeetsTheErrorConstraint) {
   EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
 }
 
+// Patches of a few vertices for their clusters (a small mesh at a large K, like the horse at
+// K = 256): the constraint still holds, through the fallback start from original CPCA.
+TEST(EpsilonSearch, HoldsWhenPatchesAreTooSmall) {
+  const cpca::Geometry g = cpca_test::grid(12);
+  const cpca::DataMatrix x = smooth_data(g, 3);
+  for (int k : {36, 48}) {
+    SCOPED_TRACE("K " + std::to_string(k));
+    cpca::CompressOptions lbg = options(cpca::ClusterMethod::kLbg, 0);
+    lbg.clusters = k;
+    cpca::CompressReport original;
+    cpca::compress(x, lbg, nullptr, &original);
+    cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchEpsilon, 0);
+    o.clusters = k;
+    cpca::CompressReport report;
+    cpca::JointSearchResult search;
+    const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
+    EXPECT_LE(report.error.average_squared_error,
+              original.error.average_squared_error * (1 + 1e-9));
+    EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
+  }
+}
+
 TEST(EpsilonSearch, DeterministicForASeed) {
   const cpca::Geometry g = cpca_test::grid(kN);
   const cpca::DataMatrix x = smooth_data(g, 9);

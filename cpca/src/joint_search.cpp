@@ -656,6 +656,31 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                               .overdraw_cap = options.overdraw_cap,
                               .error_target = target};
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
+  if (options.method == ClusterMethod::kPatchEpsilon &&
+      total_of(error) > target * double(data.rows()) * (1 + 1e-9)) {
+    // Patches too small for their clusters (a small mesh at a large K) can leave the search
+    // above the constraint. Original CPCA meets it by definition, so the search then starts
+    // from its clusters, grouped by ILS and brought to the order profile, and only cuts draws.
+    CompressOptions original = options;
+    original.method = ClusterMethod::kLbg;
+    CompressedSet from = compress(data, original, nullptr);
+    std::vector<double> from_error = reconstruction_errors(data, from);
+    SuperClusterInput input;
+    input.cluster_of = from.cluster_of;
+    input.triangles = geometry.triangles;
+    input.cluster_count = from.cluster_count;
+    input.per_pass = options.clusters_per_pass;
+    std::vector<std::uint32_t> from_pass =
+        order_profile(from.cluster_of, geometry.triangles, group_clusters("ils", input),
+                      from.cluster_count, options.clusters_per_pass);
+    JointSearchResult fr = joint_search(data, geometry, from, from_error, std::move(from_pass), jo);
+    if (total_of(from_error) < total_of(error)) {
+      fr.tried += r.tried;
+      set = std::move(from);
+      error = std::move(from_error);
+      r = std::move(fr);
+    }
+  }
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
   set.method = options.method;
   set.iterations += r.tried;
