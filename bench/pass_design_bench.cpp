@@ -4,8 +4,9 @@
 // supercluster_search.h), for patch-first and joint with the passes they were designed for
 // (cpca::designed_passes).
 // Usage: pass_design_bench TRANSFER MESH [K,...] [PER_PASS,...] [ROW,...] [MAX_STEPS]
-//   ROW: original | patch-first | joint:LAMBDA[:CAP] | patch-joint:LAMBDA[:CAP]  (CAP: the
-//   search's overdraw cap, joint_search.h)     (defaults: 64,128,192,256
+//   ROW: original | patch-first | joint:LAMBDA[:CAP] | patch-joint:LAMBDA[:CAP] (CAP: the
+//   search's overdraw cap, joint_search.h) | patch-eps[:EPS] (the epsilon constraint against
+//   the original row before it at the same K)     (defaults: 64,128,192,256
 //   3,16 original,patch-first,joint:0.5)
 #include "cpca/compress.h"
 #include "cpca/joint_search.h"
@@ -38,12 +39,19 @@ struct Row {
 };
 
 Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOptions o,
-        const std::string& row, int per_pass) {
+        const std::string& row, int per_pass, double reference_se) {
   o.clusters_per_pass = per_pass;
   if (row == "original") {
     o.method = cpca::ClusterMethod::kLbg;
   } else if (row == "patch-first") {
     o.method = cpca::ClusterMethod::kPatchFirst;
+  } else if (row.rfind("patch-eps", 0) == 0) {
+    // Against the original row's Average SE when it ran first (as prtr overdraw passes it),
+    // so the time is the method's own; else the method compresses the original itself.
+    o.method = cpca::ClusterMethod::kPatchEpsilon;
+    const auto fields = split_on(row, ':');
+    if (fields.size() > 1) o.error_slack = std::stod(fields[1]);
+    o.error_target = reference_se;
   } else {
     o.method = row.rfind("patch-joint", 0) == 0 ? cpca::ClusterMethod::kPatchJoint
                                                 : cpca::ClusterMethod::kJoint;
@@ -100,7 +108,7 @@ int main(int argc, char** argv) {
     double original_se = 0;
     for (const std::string& per_pass : per_passes)
       for (const std::string& row : rows) {
-        const Row r = run(x, g, o, row, std::stoi(per_pass));
+        const Row r = run(x, g, o, row, std::stoi(per_pass), original_se);
         if (row == "original") original_se = r.se;
         std::printf("| %s | %s | %s | %.2f | %.4e | %.3f | %.3f |\n", k.c_str(), per_pass.c_str(),
                     row.c_str(), r.seconds, r.se, original_se > 0 ? r.se / original_se : 0.0,

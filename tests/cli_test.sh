@@ -289,13 +289,16 @@ if [[ -f $forest ]]; then
   cat3ds=/usr/share/glmark2/models/cat.3ds
   if [[ -f $cat3ds ]]; then
     run overdraw "$cat3ds" --probe "$forest" --order 2 --samples 32 --bounces 0 --clusters 16 --pcs 2 \
-      --rows original,patch-first,patch-joint --strategies order --budgets thesis --frames 1 --warmup 0 \
+      --rows original,patch-first,patch-joint,patch-eps --strategies order --budgets thesis --frames 1 --warmup 0 \
       --rounds 1 --width 64 --height 48 --no-modes --cache "$tmp/od_cache" --out "$tmp/odp" -q --json
     expect_code 0; check "overdraw: patch-first and patch-joint rows run ($err)" $?
     read -r m1 s1 o0 o1 o2 < <(jget - /rows/1/method /rows/1/strategy /rows/0/average_overdraw /rows/1/average_overdraw /rows/2/average_overdraw <<<"$out" | tr '\n' ' ')
     [[ $m1 == patch-first && $s1 == order ]]; check "overdraw: the patch-first row is drawn in designed (cluster) order" $?
     awk -v a="$o0" -v b="$o1" -v c="$o2" 'BEGIN { exit !(b < a && c < a && b >= 1 && c >= 1) }'
     check "overdraw: patch-first ($o1) and patch-joint ($o2) overdraw below original in order ($o0)" $?
+    read -r se0 se3 o3 b3 < <(jget - /rows/0/average_se /rows/3/average_se /rows/3/average_overdraw /rows/3/overdraw_bound <<<"$out" | tr '\n' ' ')
+    awk -v a="$se0" -v b="$se3" -v o="$o3" -v l="$b3" 'BEGIN { exit !(b <= a * (1 + 1e-6) && l >= 1 && l <= o) }'
+    check "overdraw: patch-eps keeps Average SE ($se3) within original's ($se0), overdraw $o3 >= its bound $b3" $?
   fi
   run overdraw "$tmp/cube.obj" --probe "$forest" --rows bogus; expect_code 2 && [[ $err == *--rows* ]]; check "overdraw: unknown row is a usage error" $?
   run overdraw "$tmp/cube.obj" --probe "$forest" --strategies best; expect_code 2 && [[ $err == *--strategies* ]]; check "overdraw: unknown strategy is a usage error" $?

@@ -304,7 +304,7 @@ TEST(CompressedFile, EachCorruptionHasItsOwnMessage) {
   field("clusters0", kOffClusterCount, 0, "cluster count 0 out of range");
   field("clusters11", kOffClusterCount, 11, "cluster count 11 out of range");
   field("components17", kOffComponentCount, 17, "component count 17 out of range");
-  field("method5", kOffMethod, 5, "cluster method 5 out of range");
+  field("method6", kOffMethod, 6, "cluster method 6 out of range");
   field("solver5", kOffSolver, 5, "PCA solver 5 out of range");
   field("overdraw2", kOffOverdraw, 2, "overdraw flag 2 out of range");
   field("iterations", kOffIterations, 0x80000000u, "iteration count 2147483648 out of range");

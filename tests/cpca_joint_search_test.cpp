@@ -167,6 +167,88 @@ TEST(JointSearch, OverdrawCapBoundsTheDraws) {
   EXPECT_THROW(cpca::compress_joint(x, o, g), std::invalid_argument);
 }
 
+// patch-eps: the Average SE ends at or below (1 + eps) x original CPCA's (LBG + PCA, same K
+// and seed, compressed here independently) for several eps, and the draws it tracks are the
+// brute-force count. Where the start (patch-first) already meets the constraint the search
+// may only cut draws; where a reference below the start's error is given, it buys error back.
+TEST(EpsilonSearch, MeetsTheErrorConstraint) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 5);
+  cpca::CompressOptions lbg = options(cpca::ClusterMethod::kLbg, 0);
+  cpca::CompressReport original;
+  cpca::compress(x, lbg, nullptr, &original);
+  const double reference = original.error.average_squared_error;
+  ASSERT_GT(reference, 0);
+  cpca::CompressOptions first = options(cpca::ClusterMethod::kPatchFirst, 0);
+  cpca::CompressReport start;
+  const cpca::CompressedSet start_set = cpca::compress(x, first, &g, &start);
+  const std::uint64_t start_draws = brute_force_draws(start_set.cluster_of, g.triangles);
+  for (double eps : {0.0, 0.1, 0.5}) {
+    SCOPED_TRACE("eps " + std::to_string(eps));
+    cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchEpsilon, 0);
+    o.error_slack = eps;
+    cpca::JointSearchResult search;
+    cpca::CompressReport report;
+    const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
+    EXPECT_EQ(set.method, cpca::ClusterMethod::kPatchEpsilon);
+    EXPECT_LE(report.error.average_squared_error, (1 + eps) * reference * (1 + 1e-9));
+    EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
+    if (start.error.average_squared_error <= (1 + eps) * reference) {
+      EXPECT_LE(search.triangles_drawn, start_draws);
+    }
+    // The given reference is the same constraint as the one computed inside.
+    o.error_target = reference;
+    const cpca::CompressedSet again = cpca::compress_joint(x, o, g);
+    EXPECT_EQ(again.cluster_of, set.cluster_of);
+  }
+  // A reference below the start's error (7% below; iterative CPCA from LBG ends 14% above
+  // the start on this data): the search has to lower the error below its start.
+  cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchEpsilon, 0);
+  o.error_target = 0.93 * start.error.average_squared_error;
+  cpca::JointSearchResult search;
+  cpca::CompressReport report;
+  const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
+  EXPECT_LE(report.error.average_squared_error, o.error_target * (1 + 1e-9));
+  EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
+}
+
+// Patches of a few vertices for their clusters (a small mesh at a large K, like the horse at
+// K = 256): the constraint still holds, through the fallback start from original CPCA.
+TEST(EpsilonSearch, HoldsWhenPatchesAreTooSmall) {
+  const cpca::Geometry g = cpca_test::grid(12);
+  const cpca::DataMatrix x = smooth_data(g, 3);
+  for (int k : {36, 48}) {
+    SCOPED_TRACE("K " + std::to_string(k));
+    cpca::CompressOptions lbg = options(cpca::ClusterMethod::kLbg, 0);
+    lbg.clusters = k;
+    cpca::CompressReport original;
+    cpca::compress(x, lbg, nullptr, &original);
+    cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchEpsilon, 0);
+    o.clusters = k;
+    cpca::CompressReport report;
+    cpca::JointSearchResult search;
+    const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
+    EXPECT_LE(report.error.average_squared_error,
+              original.error.average_squared_error * (1 + 1e-9));
+    EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
+  }
+}
+
+TEST(EpsilonSearch, DeterministicForASeed) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 9);
+  cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchEpsilon, 0);
+  o.error_slack = 0.05;
+  const cpca::CompressedSet a = cpca::compress(x, o, &g);
+  const cpca::CompressedSet b = cpca::compress(x, o, &g);
+  EXPECT_EQ(a.cluster_of, b.cluster_of);
+  EXPECT_EQ(a.means, b.means);
+  EXPECT_EQ(a.bases, b.bases);
+  EXPECT_EQ(a.weights, b.weights);
+  o.error_slack = -0.1;
+  EXPECT_THROW(cpca::compress(x, o, &g), std::invalid_argument);
+}
+
 TEST(JointSearch, OrderProfilePutsTheRoomInTheLastPass) {
   const cpca::Geometry g = cpca_test::grid(6);
   std::vector<std::uint32_t> cluster_of(g.positions.size());

@@ -293,6 +293,36 @@ TEST(OverdrawReport, TablesCsvAndJsonCarryEveryRow) {
   EXPECT_EQ(overdraw::format_duration(12.44), "12.4 s");
 }
 
+// Under each table: the lowest-overdraw row whose Average SE and image RMSE are within 1.05 x
+// the original's (a lower-overdraw row with 1.2 x the SE is passed over), with its bound's gap.
+TEST(OverdrawReport, BestRowWithinTheErrorAndItsGap) {
+  overdraw::OverdrawReport r;
+  const auto add = [&](const char* method, double od, double bound, double se, double rmse) {
+    overdraw::OverdrawRow row;
+    row.clusters = 256;
+    row.method = method;
+    row.budget = "thesis";
+    row.strategy = "ils";
+    row.average_overdraw = od;
+    row.overdraw_bound = bound;
+    row.average_se = se;
+    row.image_rmse = rmse;
+    r.rows.push_back(row);
+  };
+  add("original", 1.4, 1.3, 1.0, 1.0);
+  add("patch-first", 1.10, 1.08, 1.2, 1.0);
+  add("patch-eps", 1.125, 1.1, 1.0, 1.04);
+  const std::string md = overdraw::markdown(r);
+  EXPECT_NE(md.find("| original | ils | 0.0 s | 1.400000 | 1.3000 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("Best row with Average SE and image RMSE <= 1.05 x original's: patch-eps / "
+                    "ils, overdraw 1.1250 (SE 1.000 x, RMSE 1.040 x); its bound 1.1000, gap "
+                    "0.0250; lowest bound of the table 1.0800."),
+            std::string::npos)
+      << md;
+  const nlohmann::json js = nlohmann::json::parse(overdraw::json(r));
+  EXPECT_EQ(js.at("rows").at(2).at("overdraw_bound").get<double>(), 1.1);
+}
+
 // Every string field carries a file name or a GL string the user does not control: quotes,
 // backslashes, control characters and bytes that are not UTF-8 must still give valid JSON.
 TEST(OverdrawReport, JsonSurvivesHostileStrings) {

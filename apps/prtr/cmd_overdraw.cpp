@@ -40,7 +40,8 @@ namespace fs = std::filesystem;
 
 struct Options {
   std::string mesh, probe, transfer, cache, out = "out/overdraw", pareto_plot, timing_plot;
-  std::string clusters = "64,128,192,256", rows = "original,overdraw-reduction,coherence,both";
+  std::string clusters = "64,128,192,256",
+              rows = "original,overdraw-reduction,coherence,both,patch-eps";
   std::string strategies = "order,greedy,greedy-refine,metis,ils", budgets = "default,thesis";
   int frames = 10, warmup = 2, rounds = 3, width = 1280, height = 948;
   double degrees_per_frame = 1.0;

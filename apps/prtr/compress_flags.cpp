@@ -9,6 +9,7 @@ namespace prtr_app {
 void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   cpca::CompressOptions& o = f.compress;
   const bool per_row = set == CompressFlagSet::kPerRow;
+  f.per_row = per_row;
   if (!per_row) {
     add_checked_option(cmd, "--clusters", o.clusters, "Number of CPCA clusters K",
                        integer_in(1, 65536));
@@ -20,7 +21,8 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
                     "lbg: LBG then PCA per cluster; iterative: Sloan et al. 2003 iterative CPCA; "
                     "patch-first: one METIS patch per pass, CPCA inside each; joint: local "
                     "search on Average SE + lambda x overdraw; patch-joint: that search "
-                    "started from patch-first")
+                    "started from patch-first; patch-eps: from patch-first, the least overdraw "
+                    "with Average SE <= (1 + --epsilon) x original CPCA's")
         ->check(CLI::IsMember(cpca::kClusterMethodNames.names()))
         ->capture_default_str();
   }
@@ -35,6 +37,11 @@ void add_compress_flags(CLI::App* cmd, CompressFlags& f, CompressFlagSet set) {
   add_checked_option(
       cmd, "--overdraw-tolerance", o.overdraw.tolerance,
       "Overdraw reduction: largest error increase per move, in units of the Average SE",
+      number_in(0.0, 1e6));
+  f.epsilon = add_checked_option(
+      cmd, "--epsilon", o.error_slack,
+      "patch-eps: Average SE allowed above original CPCA's at the same K, as a fraction (0 = no "
+      "worse than the original)",
       number_in(0.0, 1e6));
   if (set != CompressFlagSet::kCompress) return;
   cmd->add_option("--pca", f.pca, "power: power iteration (SLF paper); eigen: Eigen's solver")
@@ -77,10 +84,12 @@ cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
   o.solver = cpca::kPcaSolverNames.parse(f.pca);
   const bool joint =
       o.method == cpca::ClusterMethod::kJoint || o.method == cpca::ClusterMethod::kPatchJoint;
-  const bool designed = joint || o.method == cpca::ClusterMethod::kPatchFirst;
+  const bool epsilon = o.method == cpca::ClusterMethod::kPatchEpsilon;
+  const bool designed = joint || epsilon || o.method == cpca::ClusterMethod::kPatchFirst;
   if (given(f.per_pass) && !designed)
     throw UsageError(
-        "--clusters-per-pass applies to --method patch-first, joint or patch-joint only");
+        "--clusters-per-pass applies to --method patch-first, joint, patch-joint or patch-eps "
+        "only");
   if (given(f.lambda) && !joint)
     throw UsageError("--lambda applies to --method joint or patch-joint only");
   if (given(f.cap) && !joint)
@@ -88,7 +97,9 @@ cpca::CompressOptions resolve_compress_flags(const CompressFlags& f) {
   if (o.overdraw_cap > 0 && o.overdraw_cap < 1)
     throw UsageError("--overdraw-cap " + std::to_string(o.overdraw_cap) +
                      " is below 1, the least average overdraw there is: use 0 (no cap) or >= 1");
-  if (joint && (o.alpha > 0 || o.overdraw_reduction))
+  if (given(f.epsilon) && !epsilon && !f.per_row)
+    throw UsageError("--epsilon applies to --method patch-eps only");
+  if ((joint || epsilon) && (o.alpha > 0 || o.overdraw_reduction))
     throw UsageError("--method " + f.method +
                      " weighs overdraw itself (--lambda): drop --alpha and --overdraw-reduction");
   return o;

@@ -1,6 +1,7 @@
 // apps/prtr/compress_flags.h: the CPCA flags (--clusters, --pcs, --method, --alpha,
 // --overdraw-reduction, --overdraw-tolerance; and for prtr compress --pca, --seed,
-// --threshold, --max-iterations, --clusters-per-pass, --lambda, --overdraw-cap), registered with
+// --threshold, --max-iterations, --clusters-per-pass, --lambda, --overdraw-cap; --epsilon for
+// all), registered with
 // one help text by every command that compresses: prtr compress, and prtr relight / overdraw
 // through the cache.
 #pragma once
@@ -17,7 +18,8 @@ struct CompressFlags {
   cpca::CompressOptions compress;  // the defaults shown in --help
   std::string method = "lbg", pca = "power";
   // Set when registered, so that resolving can tell a given flag from its default.
-  CLI::Option *lambda = nullptr, *per_pass = nullptr, *cap = nullptr;
+  CLI::Option *lambda = nullptr, *per_pass = nullptr, *cap = nullptr, *epsilon = nullptr;
+  bool per_row = false;  // registered for prtr overdraw, whose rows choose the method
 };
 
 // Which commands register which flags: prtr compress all of them; relight the ones a cached

@@ -11,6 +11,8 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 
 namespace cpca {
 namespace {
@@ -32,7 +34,8 @@ void for_each_member_row(const RowBlocks& x, const std::vector<std::uint32_t>& m
 // of them resident.
 std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
                                  const PowerIterationOptions& power, ClusterPcaStats* stats,
-                                 const std::function<bool(int)>& fits = {}) {
+                                 const std::function<bool(int)>& fits = {},
+                                 const std::vector<float>* warm = nullptr) {
   const int k = set.cluster_count, n = set.component_count;
   const Eigen::Index d = x.cols();
   set.vertex_count = std::uint64_t(x.rows());
@@ -64,8 +67,17 @@ std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolv
     Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(n, d);
     const int rank_limit = int(std::min<Eigen::Index>({Eigen::Index(n), rows, d}));
     if (rank_limit >= 1) {
+      PowerIterationOptions po = power;
+      Eigen::MatrixXd start;
+      if (warm) {
+        start =
+            Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                warm->data() + std::size_t(c) * std::size_t(n) * std::size_t(d), n, d)
+                .cast<double>();
+        po.start = &start;
+      }
       const PcaResult pca = solver == PcaSolver::kEigen ? eigen_pca(f, rank_limit)
-                                                        : power_iteration_pca(f, rank_limit, power);
+                                                        : power_iteration_pca(f, rank_limit, po);
       basis.topRows(rank_limit) = pca.basis;
       iterations += pca.iterations;
     }
@@ -105,6 +117,18 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
 std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
                                     const PowerIterationOptions& power, ClusterPcaStats* stats) {
   return fit_clusters(x, set, solver, power, stats);
+}
+
+std::vector<double> fit_cluster_pca_warm(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
+                                         const std::vector<float>& previous_bases,
+                                         const PowerIterationOptions& power) {
+  if (previous_bases.size() !=
+      std::size_t(set.cluster_count) * std::size_t(set.component_count) * std::size_t(x.cols()))
+    throw std::invalid_argument("fit_cluster_pca_warm: the previous bases hold " +
+                                std::to_string(previous_bases.size()) +
+                                " floats, not clusters x components x dimension");
+  return fit_clusters(RowBlocks(x), set, PcaSolver::kPowerIteration, power, nullptr, {},
+                      &previous_bases);
 }
 
 namespace {

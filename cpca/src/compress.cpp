@@ -223,7 +223,8 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
   check_distributed(options, dist);
   check(data, options, geometry);
   if (options.method == ClusterMethod::kPatchFirst || options.method == ClusterMethod::kJoint ||
-      options.method == ClusterMethod::kPatchJoint) {
+      options.method == ClusterMethod::kPatchJoint ||
+      options.method == ClusterMethod::kPatchEpsilon) {
     if (!geometry) throw std::invalid_argument("the patch-first and joint methods need the mesh");
     return options.method == ClusterMethod::kPatchFirst
                ? compress_patch_first(data.all(), options, *geometry, report)

@@ -181,7 +181,7 @@ std::string field_problem(const Fields& f) {
   if (f.components < 0 || f.components > dimension) {
     return out("component count", f.components, "0 to the dimension " + std::to_string(dimension));
   }
-  if (f.method < 0 || f.method > 4)
+  if (f.method < 0 || f.method > 5)
     return out("cluster method", f.method,
                "0 lbg, 1 iterative, 2 patch-first, 3 joint, 4 patch-joint");
   if (f.solver < 0 || f.solver > 1) return out("PCA solver", f.solver, "0 power, 1 eigen");

@@ -9,6 +9,9 @@
 #include "cpca/supercluster_refine.h"
 #include "cpca/supercluster_strategy.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -143,7 +146,8 @@ std::uint64_t swap_descent(const ClusterIncidence& inc, int per_pass,
 // for bit, at the cost of the clusters that changed (late steps move few vertices).
 std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
                                   const CompressedSet& before, const std::vector<double>& error,
-                                  CompressedSet& next, const JointSearchOptions& o) {
+                                  CompressedSet& next, const JointSearchOptions& o,
+                                  bool warm = false) {
   std::vector<char> changed(std::size_t(next.cluster_count), 0);
   for (std::size_t p = 0; p < next.cluster_of.size(); ++p)
     if (next.cluster_of[p] != before.cluster_of[p])
@@ -164,8 +168,18 @@ std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
   for (std::size_t i = 0; i < rows.size(); ++i) x.row(Eigen::Index(i)) = data.row(rows[i]);
   PowerIterationOptions power;
   power.seed = o.seed;
-  const std::vector<double> part_error = fit_cluster_pca(x, part, o.solver, power);
   const std::size_t d = next.dimension(), n = std::size_t(next.component_count);
+  std::vector<double> part_error;
+  if (warm && o.solver == PcaSolver::kPowerIteration) {
+    std::vector<float> previous(ids.size() * n * d);
+    for (std::size_t j = 0; j < ids.size(); ++j)
+      std::copy_n(before.bases.begin() + std::ptrdiff_t(ids[j] * n * d), n * d,
+                  previous.begin() + std::ptrdiff_t(j * n * d));
+    power.tolerance = o.refit_tolerance;
+    part_error = fit_cluster_pca_warm(x, part, previous, power);
+  } else {
+    part_error = fit_cluster_pca(x, part, o.solver, power);
+  }
   for (std::size_t j = 0; j < ids.size(); ++j) {
     std::copy_n(part.means.begin() + std::ptrdiff_t(j * d), d,
                 next.means.begin() + std::ptrdiff_t(ids[j] * d));
@@ -187,6 +201,26 @@ ClusterIncidence incidence_of(const CompressedSet& set, const Geometry& g, int p
   input.cluster_count = set.cluster_count;
   input.per_pass = per_pass;
   return cluster_incidence(input);
+}
+
+// Each vertex's squared error under its cluster's stored mean, basis and weights, as
+// fit_cluster_pca reports it.
+std::vector<double> reconstruction_errors(const Eigen::Ref<const DataMatrix>& data,
+                                          const CompressedSet& set) {
+  std::vector<double> error(set.cluster_of.size());
+  const Eigen::Index n = set.component_count;
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, error.size(), 256), [&](const auto& range) {
+    for (std::size_t p = range.begin(); p < range.end(); ++p) {
+      const int c = int(set.cluster_of[p]);
+      Eigen::RowVectorXd r = (data.row(Eigen::Index(p)) - set.mean(c)).template cast<double>();
+      if (n > 0)
+        r -= Eigen::Map<const Eigen::RowVectorXf>(set.weights.data() + p * std::size_t(n), n)
+                 .cast<double>() *
+             set.basis(c).template cast<double>();
+      error[p] = r.squaredNorm();
+    }
+  });
+  return error;
 }
 
 // One step from (set, error, pass_of); returns false (and leaves them) unless J fell.
@@ -237,6 +271,187 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
   return (before - after) / before >= o.threshold;
 }
 
+// The epsilon search's candidates: for every vertex its own cluster (first), the other
+// clusters of its pass (a move among them costs no draws), the clusters of its 1-ring (the
+// only moves that can change draws) and, when `near` is given, the finite entries of its row
+// (the nearest means), each with its squared distance to that cluster's affine subspace under
+// the step's bases. Without `near` a step costs O(V (per_pass + ring)) distances instead of
+// iterative CPCA's V x K mean products.
+struct Candidates {
+  std::vector<std::uint32_t> offset, cluster;
+  std::vector<double> error;
+};
+
+Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set,
+                              const Geometry& g, const VertexTriangles& vt,
+                              const std::vector<std::uint32_t>& pass_of, const DataMatrix* near) {
+  const std::size_t vertices = set.cluster_of.size();
+  std::vector<std::vector<std::uint32_t>> in_pass(
+      std::size_t(*std::max_element(pass_of.begin(), pass_of.end())) + 1);
+  for (std::uint32_t c = 0; c < pass_of.size(); ++c) in_pass[pass_of[c]].push_back(c);
+  const auto list = [&](std::uint32_t p, std::vector<std::uint32_t>& out) {
+    const std::uint32_t a = set.cluster_of[p];
+    out.assign(1, a);
+    for (std::uint32_t c : in_pass[pass_of[a]])
+      if (c != a) out.push_back(c);
+    for (std::uint32_t i = vt.offset[p]; i < vt.offset[p + 1]; ++i)
+      for (std::uint32_t v : g.triangles[vt.triangle[i]]) {
+        const std::uint32_t c = set.cluster_of[v];
+        if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
+      }
+    if (!near) return;
+    const auto row = near->row(Eigen::Index(p));
+    for (Eigen::Index c = 0; c < row.size(); ++c)
+      if (std::isfinite(row[c]) && std::find(out.begin(), out.end(), std::uint32_t(c)) == out.end())
+        out.push_back(std::uint32_t(c));
+  };
+  std::vector<std::vector<std::uint32_t>> lists(vertices);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, 512), [&](const auto& range) {
+    for (std::size_t p = range.begin(); p < range.end(); ++p) list(std::uint32_t(p), lists[p]);
+  });
+  Candidates r;
+  r.offset.assign(vertices + 1, 0);
+  for (std::size_t p = 0; p < vertices; ++p)
+    r.offset[p + 1] = r.offset[p] + std::uint32_t(lists[p].size());
+  r.cluster.resize(r.offset.back());
+  r.error.resize(r.offset.back());
+  // Each cluster's candidate points in one matrix product (as subspace_distances does): one
+  // (point, cluster) pair at a time cost half the search's time.
+  std::vector<std::vector<std::uint32_t>> entries(std::size_t(set.cluster_count));
+  std::vector<std::uint32_t> point_of(r.offset.back());
+  for (std::uint32_t p = 0; p < vertices; ++p)
+    for (std::uint32_t i = 0; i < lists[p].size(); ++i) {
+      r.cluster[r.offset[p] + i] = lists[p][i];
+      point_of[r.offset[p] + i] = p;
+      entries[lists[p][i]].push_back(r.offset[p] + i);
+    }
+  const Eigen::Index d = data.cols();
+  tbb::parallel_for(0, set.cluster_count, [&](int c) {
+    const std::vector<std::uint32_t>& e = entries[std::size_t(c)];
+    if (e.empty()) return;
+    const Eigen::Map<const Eigen::RowVectorXf> mean(
+        set.means.data() + std::size_t(c) * std::size_t(d), d);
+    DataMatrix centred(Eigen::Index(e.size()), d);
+    for (std::size_t i = 0; i < e.size(); ++i)
+      centred.row(Eigen::Index(i)) = data.row(point_of[e[i]]) - mean;
+    Eigen::VectorXf residual = centred.rowwise().squaredNorm();
+    if (set.component_count > 0)
+      residual -= (centred * set.basis(c).transpose()).rowwise().squaredNorm();
+    for (std::size_t i = 0; i < e.size(); ++i)
+      r.error[e[i]] = std::max(0.0, double(residual[Eigen::Index(i)]));
+  });
+  return r;
+}
+
+// Gauss-Seidel moves minimising err + mu * draws among the bounded candidates, with the
+// step's bases fixed, under the error constraint: the running total of the members' errors
+// (under those bases) never exceeds the cap, and while it is above the cap only moves that
+// lower the error are taken. The refit that follows can only lower each cluster's error for
+// its new members, so a step that ends within the cap stays within it.
+std::int64_t sweep_epsilon(const Candidates& cand, SweepState& s, double cap,
+                           std::uint64_t& moves) {
+  const std::uint32_t vertices = std::uint32_t(s.cluster_of.size());
+  double total = 0;
+  for (std::uint32_t p = 0; p < vertices; ++p) total += cand.error[cand.offset[p]];
+  // Vertices in order of their best move's gain (err + mu * draws) at the sweep's start, so
+  // the error allowance goes to the cheapest draws first instead of to the lowest indices.
+  std::vector<double> gain(vertices, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, vertices, 512), [&](const auto& range) {
+    for (std::uint32_t p = range.begin(); p < range.end(); ++p) {
+      const std::uint32_t a = s.cluster_of[p];
+      const std::int64_t here = s.draws(p, s.pass_of[a]);
+      for (std::uint32_t i = cand.offset[p] + 1; i < cand.offset[p + 1]; ++i) {
+        const std::uint32_t c = cand.cluster[i];
+        const std::int64_t n = s.pass_of[c] == s.pass_of[a] ? here : s.draws(p, s.pass_of[c]);
+        gain[p] =
+            std::min(gain[p], cand.error[i] - cand.error[cand.offset[p]] + s.mu * double(n - here));
+      }
+    }
+  });
+  std::vector<std::uint32_t> order;
+  for (std::uint32_t p = 0; p < vertices; ++p)
+    if (gain[p] < 0) order.push_back(p);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) { return gain[a] < gain[b]; });
+  std::int64_t saved = 0;
+  for (const std::uint32_t p : order) {
+    const std::uint32_t a = s.cluster_of[p];
+    if (s.size[a] <= 1) continue;
+    const std::int64_t here = s.draws(p, s.pass_of[a]);
+    const double own = cand.error[cand.offset[p]];
+    // Above the cap every move must lower the error (draws are then only the tie-breaker the
+    // price makes them); within it no move may take the running total above it.
+    const bool above = total > cap;
+    double best = 0, best_de = 0;
+    std::uint32_t best_c = a;
+    std::int64_t best_draws = here;
+    for (std::uint32_t i = cand.offset[p] + 1; i < cand.offset[p + 1]; ++i) {
+      const std::uint32_t c = cand.cluster[i];
+      const double de = cand.error[i] - own;
+      if (above ? !(de < 0) : total + de > cap) continue;
+      const std::int64_t n = s.pass_of[c] == s.pass_of[a] ? here : s.draws(p, s.pass_of[c]);
+      const double delta = de + s.mu * double(n - here);
+      if (delta < best) best = delta, best_c = c, best_draws = n, best_de = de;
+    }
+    if (best_c == a) continue;
+    --s.size[a], ++s.size[best_c];
+    s.cluster_of[p] = best_c;
+    total += best_de;
+    saved += here - best_draws;
+    s.drawn = std::uint64_t(std::int64_t(s.drawn) + best_draws - here);
+    ++moves;
+  }
+  return saved;
+}
+
+// One epsilon step: bounded sweep at price mu, warm refit, pass swaps. The proposal is kept
+// when it lowers (violation of the error cap, triangles drawn, error) lexicographically.
+// Returns whether it was kept; `feasible` tells whether the proposal met the cap.
+bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
+                  const VertexTriangles& vt, const Eigen::VectorXf& norms,
+                  const JointSearchOptions& o, double mu, double cap_total, CompressedSet& set,
+                  std::vector<double>& error, std::vector<std::uint32_t>& pass_of,
+                  JointSearchResult& r, bool& feasible) {
+  // Above the cap the search needs error-lowering moves, which the nearest means offer (as
+  // in iterative CPCA); within it only moves that change draws matter, and those are bounded
+  // to the 1-ring, so the V x K distance products are skipped.
+  const bool above = total_of(error) > cap_total;
+  const DataMatrix near = above ? subspace_distances(data, norms, set, o.candidates) : DataMatrix();
+  const Candidates cand = bounded_candidates(data, set, g, vt, pass_of, above ? &near : nullptr);
+  CompressedSet next = set;
+  std::vector<std::uint32_t> next_pass = pass_of;
+  std::uint64_t moves = 0, swaps = 0;
+  std::vector<std::uint32_t> size(std::size_t(set.cluster_count), 0);
+  for (std::uint32_t c : set.cluster_of) ++size[c];
+  const double before_error = total_of(error);
+  SweepState s{g.triangles, vt, next_pass,         next.cluster_of,
+               size,        mu, r.triangles_drawn, std::numeric_limits<std::uint64_t>::max()};
+  std::uint64_t drawn = r.triangles_drawn;
+  drawn -= std::uint64_t(sweep_epsilon(cand, s, cap_total, moves));
+  std::vector<double> next_error = refit_changed(data, set, error, next, o, true);
+  const ClusterIncidence inc = incidence_of(next, g, o.per_pass);
+  PRTR_DCHECK(triangles_drawn(inc, next_pass) == drawn);
+  drawn = swap_descent(inc, o.per_pass, next_pass, swaps);
+  const double after_error = total_of(next_error);
+  const double violation_before = std::max(0.0, before_error - cap_total);
+  const double violation_after = std::max(0.0, after_error - cap_total);
+  feasible = violation_after == 0;
+  const bool better = violation_before > 0
+                          ? violation_after < violation_before
+                          : feasible && (drawn < r.triangles_drawn || (drawn == r.triangles_drawn &&
+                                                                       after_error < before_error));
+  if (!better) return false;
+  set = std::move(next);
+  error = std::move(next_error);
+  pass_of = std::move(next_pass);
+  r.triangles_drawn = drawn;
+  r.vertex_moves += moves;
+  r.pass_swaps += swaps;
+  r.objective.push_back(after_error / double(data.rows()));
+  ++r.steps;
+  return true;
+}
+
 // Clusters renumbered so that pass p holds [p * per_pass, ...): the order grouping.
 void renumber_by_pass(CompressedSet& set, const std::vector<std::uint32_t>& pass_of, int per_pass) {
   std::vector<std::uint32_t> id(pass_of.size());
@@ -261,7 +476,8 @@ void renumber_by_pass(CompressedSet& set, const std::vector<std::uint32_t>& pass
 CompressedSet joint_start(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
                           const Geometry& geometry, CompressReport& rep, std::vector<double>& error,
                           std::vector<std::uint32_t>& pass_of) {
-  const bool patches = options.method == ClusterMethod::kPatchJoint;
+  const bool patches = options.method == ClusterMethod::kPatchJoint ||
+                       options.method == ClusterMethod::kPatchEpsilon;
   CompressOptions start = options;
   start.method = ClusterMethod::kLbg;
   CompressedSet set = patches ? compress_patch_first(data, options, geometry, &rep)
@@ -270,7 +486,12 @@ CompressedSet joint_start(const Eigen::Ref<const DataMatrix>& data, const Compre
   // patch-first, a fit of the same clusters over the whole data).
   PowerIterationOptions power;
   power.seed = options.seed;
-  error = fit_cluster_pca(data, set, options.solver, power);
+  if (options.method == ClusterMethod::kPatchEpsilon)
+    // The stitched patches already hold each cluster's fit of its members: only the errors
+    // are missing, and a second fit of every cluster would cost as much as the start.
+    error = reconstruction_errors(data, set);
+  else
+    error = fit_cluster_pca(data, set, options.solver, power);
   if (patches) {
     pass_of.resize(std::size_t(set.cluster_count));
     for (std::uint32_t c = 0; c < pass_of.size(); ++c)
@@ -345,6 +566,36 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
   }
   const VertexTriangles vt(std::size_t(data.rows()), geometry.triangles);
   const Eigen::VectorXf norms = data.rowwise().squaredNorm();
+  if (options.error_target > 0) {
+    // The epsilon-constraint search: the price of a drawn triangle is a Lagrange multiplier
+    // found by the search itself (below), so no weight needs setting per mesh or K.
+    const double cap_total = options.error_target * double(data.rows());
+    double price = 2 * total / t;
+    r.triangles_drawn = swap_descent(inc, options.per_pass, pass_of, r.pass_swaps);
+    for (int i = 1, rejected = 0; i <= options.max_steps && rejected < 3; ++i) {
+      r.tried = i;
+      bool feasible = false;
+      const double error_before = total_of(vertex_error);
+      const std::uint64_t drawn_before = r.triangles_drawn;
+      const bool kept = epsilon_step(data, geometry, vt, norms, options, price, cap_total, set,
+                                     vertex_error, pass_of, r, feasible);
+      // A kept step that moved neither draws nor error by the threshold counts as a stall.
+      const bool moved =
+          kept && (double(drawn_before) - double(r.triangles_drawn) >=
+                       options.threshold * double(drawn_before) ||
+                   error_before - total_of(vertex_error) >= options.threshold * error_before);
+      rejected = moved ? 0 : rejected + 1;
+      // Dual ascent on the constraint: a draw gets cheaper while the error is above the cap
+      // and dearer (faster: the allowance is spent in few steps) while more than 1% of it is
+      // left unspent.
+      if (!feasible)
+        price *= 0.5;
+      else if (total_of(vertex_error) < 0.99 * cap_total || !kept)
+        price *= 4;
+    }
+    r.pass_of = std::move(pass_of);
+    return r;
+  }
   for (int i = 1; i <= options.max_steps && total_of(vertex_error) > 0; ++i) {
     r.tried = i;
     if (!step(data, geometry, vt, norms, options, mu, set, vertex_error, pass_of, r)) break;
@@ -368,9 +619,31 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   CompressReport& rep = report ? *report : local;
   rep = CompressReport{};
   auto t = Clock::now();
+  double target = 0;
+  double reference_seconds = 0;
+  if (options.method == ClusterMethod::kPatchEpsilon) {
+    if (!(options.error_slack >= 0) || !std::isfinite(options.error_slack))
+      throw std::invalid_argument(
+          "patch-eps: the error slack (epsilon) must be finite and >= 0, "
+          "got " +
+          std::to_string(options.error_slack));
+    double reference = options.error_target;
+    if (!(reference > 0)) {
+      CompressOptions original = options;
+      original.method = ClusterMethod::kLbg;
+      CompressReport original_report;
+      compress(data, original, nullptr, &original_report);
+      reference = original_report.error.average_squared_error;
+      reference_seconds = seconds(t);
+    }
+    target = (1 + options.error_slack) * reference;
+    // An exact reference (zero error) leaves no room: any positive cap below float rounding.
+    if (!(target > 0)) target = std::numeric_limits<double>::min();
+  }
   std::vector<double> error;
   std::vector<std::uint32_t> pass_of;
   CompressedSet set = joint_start(data, options, geometry, rep, error, pass_of);
+  rep.lbg_seconds += reference_seconds;
   const double start_seconds = seconds(t);
   t = Clock::now();
   const JointSearchOptions jo{.lambda = options.lambda,
@@ -380,14 +653,45 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
                               .candidates = options.cpca_candidates,
                               .solver = options.solver,
                               .seed = options.seed,
-                              .overdraw_cap = options.overdraw_cap};
+                              .overdraw_cap = options.overdraw_cap,
+                              .error_target = target};
   JointSearchResult r = joint_search(data, geometry, set, error, std::move(pass_of), jo);
+  if (options.method == ClusterMethod::kPatchEpsilon &&
+      total_of(error) > target * double(data.rows()) * (1 + 1e-9)) {
+    // Patches too small for their clusters (a small mesh at a large K) can leave the search
+    // above the constraint. Original CPCA meets it by definition, so the search then starts
+    // from its clusters, grouped by ILS and brought to the order profile, and only cuts draws.
+    CompressOptions original = options;
+    original.method = ClusterMethod::kLbg;
+    CompressedSet from = compress(data, original, nullptr);
+    std::vector<double> from_error = reconstruction_errors(data, from);
+    SuperClusterInput input;
+    input.cluster_of = from.cluster_of;
+    input.triangles = geometry.triangles;
+    input.cluster_count = from.cluster_count;
+    input.per_pass = options.clusters_per_pass;
+    std::vector<std::uint32_t> from_pass =
+        order_profile(from.cluster_of, geometry.triangles, group_clusters("ils", input),
+                      from.cluster_count, options.clusters_per_pass);
+    JointSearchResult fr = joint_search(data, geometry, from, from_error, std::move(from_pass), jo);
+    if (total_of(from_error) < total_of(error)) {
+      fr.tried += r.tried;
+      set = std::move(from);
+      error = std::move(from_error);
+      r = std::move(fr);
+    }
+  }
   renumber_by_pass(set, r.pass_of, options.clusters_per_pass);
   set.method = options.method;
   set.iterations += r.tried;
   rep.cpca_seconds = seconds(t);
   rep.cpca_iterations = r.tried;
   rep.pca_seconds = start_seconds - rep.lbg_seconds;
+  if (options.method == ClusterMethod::kPatchEpsilon) {
+    // Its clustering time is all of it: the reference, the start and its fit, the search.
+    rep.lbg_seconds = start_seconds;
+    rep.pca_seconds = 0;
+  }
   rep.error = error_metrics(data, set);
   rep.has_geometry = true;
   rep.span = triangle_span(set.cluster_of, geometry.triangles);

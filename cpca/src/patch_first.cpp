@@ -179,7 +179,10 @@ CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,
       partition_patches(data, geometry, counts, options.seed);
   // Each patch is compressed alone, so the whole set is built from ordinary compressions.
   CompressOptions inner = options;
-  inner.method = ClusterMethod::kIterative;
+  // patch-eps refines the whole set afterwards with its own refits, so its patches stop at
+  // LBG + PCA instead of running iterative CPCA inside each.
+  inner.method = options.method == ClusterMethod::kPatchEpsilon ? ClusterMethod::kLbg
+                                                                : ClusterMethod::kIterative;
   CompressedSet set;
   std::vector<CompressedSet> parts(counts.size());
   std::vector<Patch> patches(counts.size());

@@ -51,6 +51,11 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
   for (int p = 0; p < k; ++p) {
     for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = next_uniform(state) - 0.5;
     v.normalize();
+    if (options.start && p < options.start->rows() && options.start->cols() == n) {
+      Eigen::VectorXd warm = result.gram ? Eigen::VectorXd(f * options.start->row(p).transpose())
+                                         : Eigen::VectorXd(options.start->row(p).transpose());
+      if (const double norm = warm.norm(); norm > 1e-9 * std::sqrt(scale)) v = warm / norm;
+    }
     double lambda = 0.0, previous_change = std::numeric_limits<double>::infinity();
     for (int it = 0; it < options.max_iterations; ++it) {
       ++result.iterations;

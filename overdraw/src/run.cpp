@@ -3,6 +3,7 @@
 #include "pipeline/pipeline.h"
 
 #include "cpca/compressed_file.h"
+#include "cpca/overdraw_bound.h"
 #include "cpca/supercluster.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
@@ -46,6 +47,10 @@ constexpr MethodPreset kMethods[] = {
     {"patch-joint",
      "patch-first, then the joint search of error + 0.5 x overdraw, overdraw capped at 1.14", false,
      false, false, cpca::ClusterMethod::kPatchJoint, 0.5, 1.14},
+    {"patch-eps",
+     "patch-first, then the least overdraw with Average SE <= (1 + --epsilon) x original's "
+     "(epsilon constraint; recommended)",
+     false, false, false, cpca::ClusterMethod::kPatchEpsilon},
 };
 
 bool has(const std::vector<std::string>& list, const char* item) {
@@ -228,6 +233,14 @@ Compression compress_row(const Scene& s, const std::string& transfer_path, int k
     co.lambda = method.lambda;
     co.overdraw_cap = method.overdraw_cap;
   }
+  if (method.designed == cpca::ClusterMethod::kPatchEpsilon) {
+    // The constraint's reference is the original row's Average SE at this K (the cached
+    // compression when that row ran): the row reports only its own clustering time.
+    bool original_cached = false;
+    co.error_target =
+        compress_row(s, transfer_path, k, find_method("original"), 0, &original_cached)
+            .summary.average_se;
+  }
   // Compressions run without a progress bar (the run has its own), but cache repairs are told.
   pipeline::Reporter warnings_only;
   warnings_only.warning = plan.reporter.warning;
@@ -313,6 +326,7 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   const double grouping_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - g0).count();
   const cpca::OverdrawStats od = cpca::overdraw(c.set.cluster_of, s.geometry.triangles, groups);
+  const cpca::GroupingBound bound = cpca::grouping_overdraw_bound(input);
 
   const auto r = multipass_renderer(s, c, budget, per_pass, groups);
   r->set_count_primitives(true);  // one query per pass; timed frames draw without them
@@ -336,6 +350,7 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   row.clustering_seconds = c.summary.clustering_seconds;
   row.grouping_seconds = grouping_seconds;
   row.average_overdraw = od.average_overdraw;
+  row.overdraw_bound = bound.average_overdraw;
   row.triangles_drawn = od.triangles_drawn;
   row.average_se = c.summary.average_se;
   row.relative_error = c.summary.relative_error;

@@ -254,6 +254,9 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
   if (o.method == cpca::ClusterMethod::kPatchFirst || o.method == cpca::ClusterMethod::kJoint ||
       o.method == cpca::ClusterMethod::kPatchJoint)
     key << " per-pass " << o.clusters_per_pass << " lambda " << o.lambda;
+  if (o.method == cpca::ClusterMethod::kPatchEpsilon)
+    key << " per-pass " << o.clusters_per_pass << " eps " << o.error_slack << " target "
+        << o.error_target;
   if (o.overdraw_cap > 0) key << " cap " << o.overdraw_cap;
   const std::string stem = "cpca-" + hex(hash_text(key.str()));
   CompressCacheResult r;

@@ -26,6 +26,13 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
                                     PcaSolver solver, const PowerIterationOptions& power = {},
                                     ClusterPcaStats* stats = nullptr);
 
+// The same, each cluster's power iteration started from `previous_bases` (K x N x D floats, as
+// CompressedSet::bases) of the same cluster id, with power.tolerance as given: a refit after a
+// search moved some points. Power-iteration solver only.
+std::vector<double> fit_cluster_pca_warm(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
+                                         const std::vector<float>& previous_bases,
+                                         const PowerIterationOptions& power);
+
 // The same, out of core: each cluster gathers only its own rows (random access through
 // x.all()) and the source's pages are released after every cluster, so memory holds the
 // clusters being fitted (one per thread), not the data. Bit-identical to the call above.

@@ -47,6 +47,12 @@ struct CompressOptions {
   int clusters_per_pass = 16;
   double lambda = 0.0;
   double overdraw_cap = 0.0;
+  // patch-eps (joint_search.h): the least overdraw with Average SE <= (1 + error_slack) x a
+  // reference, the Average SE of original CPCA (LBG + PCA, same K and seed). error_target > 0
+  // gives that reference's Average SE (a caller that has already compressed the original);
+  // 0 makes the method compress the original itself, inside its clustering time.
+  double error_slack = 0.0;
+  double error_target = 0.0;
 };
 
 // Triangles whose three vertices lie in 1, 2 or 3 distinct clusters.

@@ -22,18 +22,20 @@ namespace cpca {
 
 // How the clusters were formed; recorded in the compressed file for reports.
 enum class ClusterMethod : std::uint32_t {
-  kLbg = 0,         // LBG / k-means on the data, PCA per cluster afterwards (thesis "original")
-  kIterative = 1,   // Sloan et al. 2003 iterative CPCA: reassign by reconstruction error
-  kPatchFirst = 2,  // mesh cut into one patch per pass, CPCA inside each (patch_first.h)
-  kJoint = 3,       // local search on error + lambda * overdraw (joint_search.h)
-  kPatchJoint = 4,  // the joint search started from patch-first's clusters and passes
+  kLbg = 0,           // LBG / k-means on the data, PCA per cluster afterwards (thesis "original")
+  kIterative = 1,     // Sloan et al. 2003 iterative CPCA: reassign by reconstruction error
+  kPatchFirst = 2,    // mesh cut into one patch per pass, CPCA inside each (patch_first.h)
+  kJoint = 3,         // local search on error + lambda * overdraw (joint_search.h)
+  kPatchJoint = 4,    // the joint search started from patch-first's clusters and passes
+  kPatchEpsilon = 5,  // patch-first, then the least overdraw with Average SE <= a target
 };
 inline constexpr auto kClusterMethodNames = common::enum_table<ClusterMethod>(
     "clustering method", {{ClusterMethod::kLbg, "lbg"},
                           {ClusterMethod::kIterative, "iterative"},
                           {ClusterMethod::kPatchFirst, "patch-first"},
                           {ClusterMethod::kJoint, "joint"},
-                          {ClusterMethod::kPatchJoint, "patch-joint"}});
+                          {ClusterMethod::kPatchJoint, "patch-joint"},
+                          {ClusterMethod::kPatchEpsilon, "patch-eps"}});
 
 enum class PcaSolver : std::uint32_t {
   kPowerIteration = 0,  // SLF paper Algorithm 1 (default)

@@ -41,6 +41,16 @@ struct JointSearchOptions {
   // may only come down). A constraint, not a weight: with a small lambda the search spends
   // the overdraw budget on error, and J still never rises.
   double overdraw_cap = 0.0;
+  // > 0: the epsilon-constraint search (Haimes, Lasdon & Wismer 1971) instead: minimise the
+  // triangles drawn subject to Average SE <= error_target. lambda and overdraw_cap are then
+  // unused: the price of a drawn triangle is a multiplier the search adapts (halved while the
+  // error is above the target, quadrupled while more than 1% of the allowance is unspent).
+  // Its moves are bounded (a vertex considers the clusters of its pass and of its 1-ring, and
+  // the nearest means only while the error is above the target), and its refits start from
+  // the previous bases (refit_tolerance). Stops after max_steps or 3 steps in a row that move
+  // neither draws nor error by `threshold`.
+  double error_target = 0.0;
+  double refit_tolerance = 1e-6;  // the bases are stored as floats
 };
 
 struct JointSearchResult {

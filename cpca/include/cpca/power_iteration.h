@@ -26,6 +26,12 @@ struct PowerIterationOptions {
   double tolerance = 1e-12;
   int max_iterations = 1000;
   std::uint64_t seed = 1;  // of the start vectors; the result is deterministic
+  // Optional warm start: k x n directions (a previous fit of nearly the same points). Row p
+  // starts component p (on the Gram path projected onto the points, F b_p, the left singular
+  // vector it would give); a zero or vanishing start falls back to the seeded random one.
+  // A search that refits clusters after moving a few points converges in a fraction of the
+  // iterations from here.
+  const Eigen::MatrixXd* start = nullptr;
 };
 
 struct PcaResult {
