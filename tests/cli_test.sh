@@ -49,7 +49,7 @@ run mesh a.obj --bogus; expect_code 2; check "unknown flag exits 2" $?
 # and its ~200 process starts cost several minutes there.
 numeric_flags=0
 others=("-1" "abc" "1e400" "99999999999999999999999")
-subcommands=(bake compress merge mesh probe info render relight overdraw view gl-info slf path-trace)
+subcommands=(bake compress merge mesh probe info render relight overdraw view gl-info slf path-trace compare)
 [[ ${PRTR_CLI_SWEEP:-1} == 0 ]] && { subcommands=(); skip "numeric flag sweep (PRTR_CLI_SWEEP=0)"; }
 for sub in "${subcommands[@]}"; do
   while read -r flag; do
@@ -457,6 +457,21 @@ if [[ -f $forest ]]; then
   expect_code 2 && [[ $err == *--samples* ]]; check "slf: --samples without WxH is a usage error naming it" $?
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 -o "$tmp/pt.exr" -q
   expect_code 0 && [[ -s $tmp/pt.exr ]]; check "path-trace writes an EXR" $?
+  # prtr render shows the .slfc in one pass; PRT's lighting flags and another probe are refused.
+  run render "$tmp/cube.slfc" --probe "$forest" --width 16 --height 12 --frames 2 --warmup 0 -o "$tmp/slf.exr" --json -q
+  expect_code 0 && [[ $out == *'"mode":"slf"'* && $out == *'"passes":1'* && -s $tmp/slf.exr ]]; check "render: a .slfc renders in one pass" $?
+  run render "$tmp/cube.slfc" --probe "$forest" --rotate-deg 30 -o "$tmp/x.exr" -q
+  expect_code 2 && [[ $err == *--rotate-deg* && $err == *"surface light field"* ]]; check "render: --rotate-deg on a .slfc is a usage error naming it" $?
+  run render "$tmp/cube.slfc" --probe "${forest%forest.exr}city.exr" -o "$tmp/x.exr" -q
+  expect_code 2 && [[ $err == *--probe* && $err == *forest.exr* ]]; check "render: a .slfc under another probe is a usage error naming the baked one" $?
+  # prtr compare: an image against itself is exact; against the path-traced one it is not.
+  run compare "$tmp/slf.exr" "$tmp/slf.exr" --json
+  expect_code 0 && [[ $out == *'"relative_rmse":0'* ]]; check "compare: an image against itself has no error" $?
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --json
+  expect_code 0 && [[ $out == *'"relative_rmse":0.'* ]]; check "compare: the SLF against the path tracer reports a relative RMSE" $?
+  run path-trace "$tmp/cube.obj" --probe "$forest" --width 8 --height 6 --spp 1 -o "$tmp/pt2.exr" -q
+  run compare "$tmp/slf.exr" "$tmp/pt2.exr"
+  expect_code 1 && [[ $err == *"differ in size"* ]]; check "compare: images of different sizes are refused naming both" $?
 fi
 
 echo "cli: $passed passed, $failed failed"

@@ -3,6 +3,7 @@
 // atomic, and the default camera frames the bounding sphere.
 #include "render/camera.h"
 #include "render/image.h"
+#include "render/image_difference.h"
 #include "render/renderer.h"
 
 #include "meshes/procedural.h"
@@ -178,3 +179,44 @@ TEST(Camera, PixelDirectionsMatchTheProjection) {
 }
 
 }  // namespace
+
+namespace {
+
+render::Image flat_image(int w, int h, float value, float alpha) {
+  render::Image image;
+  image.width = w;
+  image.height = h;
+  image.rgba.assign(std::size_t(w) * h * 4, value);
+  for (std::size_t i = 3; i < image.rgba.size(); i += 4) image.rgba[i] = alpha;
+  return image;
+}
+
+}  // namespace
+
+// Worked by hand: over the covered pixels the error is 0.5 on one pixel's three channels and
+// 0 elsewhere, the reference 2 everywhere; uncovered pixels, whatever they hold, do not count.
+TEST(ImageDifference, CountsOnlyPixelsBothCoverAndMatchesAHandComputation) {
+  render::Image reference = flat_image(4, 2, 2.f, 1.f);
+  render::Image image = reference;
+  for (int c = 0; c < 3; ++c) image.pixel(1, 0)[c] = 2.5f;
+  for (int c = 0; c < 3; ++c) image.pixel(3, 1)[c] = 100.f;  // not covered in the reference
+  reference.pixel(3, 1)[3] = 0.f;
+  const render::ImageDifference d = render::image_difference(image, reference);
+  EXPECT_EQ(d.pixels, 7u);
+  const double rmse = std::sqrt(3 * 0.25 / 21.0);
+  EXPECT_NEAR(d.rmse, rmse, 1e-12);
+  EXPECT_NEAR(d.relative_rmse, rmse / 2.0, 1e-12);
+  EXPECT_NEAR(d.mean_abs, 1.5 / 21.0, 1e-12);
+  EXPECT_NEAR(d.max_abs, 0.5, 1e-12);
+  // Coverage 0 counts every pixel, the uncovered one's 98 included.
+  EXPECT_NEAR(render::image_difference(image, reference, 0.f).max_abs, 98.0, 1e-9);
+}
+
+TEST(ImageDifference, RefusesDifferentSizesNoCoverageAndNonFiniteValues) {
+  const render::Image a = flat_image(4, 2, 1.f, 1.f);
+  EXPECT_THROW(render::image_difference(a, flat_image(2, 4, 1.f, 1.f)), std::invalid_argument);
+  EXPECT_THROW(render::image_difference(a, flat_image(4, 2, 1.f, 0.f)), std::invalid_argument);
+  render::Image nan = a;
+  nan.pixel(0, 0)[1] = std::nanf("");
+  EXPECT_THROW(render::image_difference(nan, a), std::invalid_argument);
+}

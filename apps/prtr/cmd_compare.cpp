@@ -49,8 +49,8 @@ void run(const Options& o, CLI::App*) {
   }
   std::printf("pixels         %llu covered in both\n", static_cast<unsigned long long>(d.pixels));
   std::printf("relative RMSE  %.4f (%.2f %%)\n", d.relative_rmse, 100.0 * d.relative_rmse);
-  std::printf("RMSE           %.6g\nmean |error|   %.6g\nmax |error|    %.6g\n", d.rmse,
-              d.mean_abs, d.max_abs);
+  std::printf("RMSE           %.6g\nmean |error|   %.6g\nmax |error|    %.6g\n", d.rmse, d.mean_abs,
+              d.max_abs);
 }
 
 }  // namespace cmd_compare

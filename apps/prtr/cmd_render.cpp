@@ -11,12 +11,10 @@
 #include "view_flags.h"
 
 #include "cpca/compressed_file.h"
-#include "meshes/atlas.h"
-#include "pipeline/slf_file.h"
-#include "render/slf_from_compressed.h"
-#include "render/slf_renderer.h"
 #include "cpca/supercluster_strategy.h"
+#include "meshes/atlas.h"
 #include "meshes/load.h"
+#include "pipeline/slf_file.h"
 #include "probes/load.h"
 #include "prt/projection.h"
 #include "prt/sh_rotation.h"
@@ -25,12 +23,14 @@
 #include "render/gl_context.h"
 #include "render/image.h"
 #include "render/renderer.h"
+#include "render/slf_from_compressed.h"
+#include "render/slf_renderer.h"
 #include "render/supersample.h"
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -63,7 +63,9 @@ struct Options {
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
-  cmd->add_option("COMPRESSED", o.compressed, "Compressed transfer (.prtc) or surface light field (.slfc)")->required();
+  cmd->add_option("COMPRESSED", o.compressed,
+                  "Compressed transfer (.prtc) or surface light field (.slfc)")
+      ->required();
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("-o,--output", o.output, "EXR to write (linear RGB, alpha = coverage)")
       ->required();
@@ -230,9 +232,9 @@ bool is_slfc(const std::string& path) {
 // lighting is baked, so only the camera moves; the probe is the background and must be the
 // one it was baked under.
 void run_slf(const Options& o, CLI::App* cmd) {
-  for (const char* flag : {"--mode", "--transfer", "--rotate-deg", "--spin-deg",
-                           "--register-budget", "--clusters-per-pass", "--strategy",
-                           "--accumulation", "--constants"})
+  for (const char* flag :
+       {"--mode", "--transfer", "--rotate-deg", "--spin-deg", "--register-budget",
+        "--clusters-per-pass", "--strategy", "--accumulation", "--constants"})
     if (cmd->count(flag))
       throw UsageError(std::string(flag) + " applies to PRT sets (.prtc); " + o.compressed +
                        " is a surface light field, whose lighting is baked and which renders "
@@ -253,11 +255,11 @@ void run_slf(const Options& o, CLI::App* cmd) {
                              "--crease-angle it was made with)");
   const probes::Probe probe = probes::load_probe(o.probe);
   if (prt::probe_hash(probe) != slf.bake.probe_hash)
-    throw UsageError("--probe: " + o.compressed + " was baked under " + slf.probe_name +
-                     ", not " + o.probe + "; a surface light field's lighting is fixed, so "
+    throw UsageError("--probe: " + o.compressed + " was baked under " + slf.probe_name + ", not " +
+                     o.probe +
+                     "; a surface light field's lighting is fixed, so "
                      "pass the probe it was made with");
-  const meshes::Atlas atlas =
-      meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height);
+  const meshes::Atlas atlas = meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height);
   const render::SlfModel model =
       render::slf_model_from_compressed(mesh, atlas, slf.bake.grid, slf.set);
   const render::Background background = resolve_background(o.view);
@@ -266,6 +268,9 @@ void run_slf(const Options& o, CLI::App* cmd) {
   render::GlContext context(gl);
   render::SlfRendererOptions ro;
   ro.cull_back_faces = !o.no_cull;
+  // llvmpipe shades whole 4 x 4 blocks, so small triangles cost the one-pass shader several
+  // times their pixels; the deferred pass (same image) shades each covered pixel once.
+  ro.deferred = context.info().software_rasterizer();
   render::SlfRenderer renderer(model, &probe, ro);
   renderer.set_background(background);
   for (int i = 0; i < o.warmup; ++i) renderer.render(camera);
@@ -280,10 +285,12 @@ void run_slf(const Options& o, CLI::App* cmd) {
   if (!o.quiet) {
     std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
                 o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
-    std::printf("slf         one pass, %d cluster(s), %d PCA term(s), %d x %d texels, %d x %d "
-                "directions, baked under %s\n",
-                model.clusters, model.components, model.map_width, model.map_height,
-                model.grid.azimuth, model.grid.elevation, slf.probe_name.c_str());
+    std::printf(
+        "slf         %s, %d cluster(s), %d PCA term(s), %d x %d texels, %d x %d "
+        "directions, baked under %s\n",
+        ro.deferred ? "one shading pass after a uv pass" : "one pass", model.clusters,
+        model.components, model.map_width, model.map_height, model.grid.azimuth,
+        model.grid.elevation, slf.probe_name.c_str());
     std::printf("timing      %.2f FPS: frame %.2f ms median over %d frames\n",
                 median > 0 ? 1000.0 / median : 0.0, median, o.frames);
     std::printf("image       %d x %d samples per pixel, %.2f ms for the written frame\n",

@@ -18,9 +18,9 @@
 namespace meshes {
 
 struct Atlas {
-  int width = 0, height = 0;           // texels
-  std::vector<Eigen::Vector2f> uv{};   // 3 per triangle (corner 3 t + i), in [0, 1]^2; texel
-                                       // x's centre is at (x + 0.5) / width
+  int width = 0, height = 0;          // texels
+  std::vector<Eigen::Vector2f> uv{};  // 3 per triangle (corner 3 t + i), in [0, 1]^2; texel
+                                      // x's centre is at (x + 0.5) / width
   // Per texel, row-major (y * width + x): the triangle whose lookups read it (-1: none) and
   // the barycentrics (u, v) of the surface point it samples, p = (1-u-v) p0 + u p1 + v p2.
   std::vector<std::int32_t> texel_triangle{};

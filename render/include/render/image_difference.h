@@ -18,6 +18,7 @@ struct ImageDifference {
 
 // Throws std::invalid_argument when the sizes differ, nothing is compared or a compared
 // value is not finite.
-ImageDifference image_difference(const Image& image, const Image& reference, float coverage = 0.999f);
+ImageDifference image_difference(const Image& image, const Image& reference,
+                                 float coverage = 0.999f);
 
 }  // namespace render
