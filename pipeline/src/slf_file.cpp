@@ -20,14 +20,10 @@ constexpr common::VersionedFormat kSlfcFormat{"compressed surface light field fi
                                               {'P', 'R', 'T', 'R', 'S', 'L', 'F', 'C'},
                                               kSlfcFileVersion};
 
-constexpr std::size_t kSlfcOffWidth = 16, kSlfcOffHeight = 20, kSlfcOffAzimuth = 24,
-                      kSlfcOffElevation = 28, kSlfcOffSpp = 32, kSlfcOffBounces = 36,
-                      kSlfcOffKind = 40, kSlfcOffMasking = 44, kSlfcOffRows = 48,
-                      kSlfcOffMeshHash = 56, kSlfcOffAlbedo = 64, kSlfcOffSpecular = 76,
-                      kSlfcOffExponent = 80, kSlfcOffRoughness = 84, kSlfcOffF0 = 88,
-                      kSlfcOffClusters = 92, kSlfcOffComponents = 96, kSlfcOffMeshPath = 100,
-                      kSlfcOffProbeName = 102, kSlfcOffPayloadChecksum = 104,
-                      kSlfcOffProbeHash = 112;
+// Bytes 16-47, 56-91 and 112 hold the bake's settings as the .slf does (prt::put_slf_settings).
+constexpr std::size_t kSlfcOffRows = 48, kSlfcOffClusters = 92, kSlfcOffComponents = 96,
+                      kSlfcOffMeshPath = 100, kSlfcOffProbeName = 102,
+                      kSlfcOffPayloadChecksum = 104;
 constexpr std::size_t kSettingsBytes = 48;
 
 std::size_t padded(std::size_t bytes) {
@@ -144,27 +140,13 @@ void write_slfc(const std::filesystem::path& path, const CompressedSlf& slf) {
   append(body, set.bases.data(), set.bases.size() * 4);
 
   common::VersionedHeader h = common::begin_header(kSlfcFormat);
-  common::put_field(h, kSlfcOffWidth, std::uint32_t(b.atlas_width));
-  common::put_field(h, kSlfcOffHeight, std::uint32_t(b.atlas_height));
-  common::put_field(h, kSlfcOffAzimuth, std::uint32_t(b.grid.azimuth));
-  common::put_field(h, kSlfcOffElevation, std::uint32_t(b.grid.elevation));
-  common::put_field(h, kSlfcOffSpp, std::uint32_t(b.spp));
-  common::put_field(h, kSlfcOffBounces, std::uint32_t(b.bounces));
-  common::put_field(h, kSlfcOffKind, std::uint32_t(b.material.kind));
-  common::put_field(h, kSlfcOffMasking, std::uint32_t(b.material.masking));
+  prt::put_slf_settings(h, b);
   common::put_field(h, kSlfcOffRows, b.rows);
-  common::put_field(h, kSlfcOffMeshHash, b.mesh_hash);
-  for (int c = 0; c < 3; ++c) common::put_field(h, kSlfcOffAlbedo + 4 * c, b.material.albedo[c]);
-  common::put_field(h, kSlfcOffSpecular, b.material.specular);
-  common::put_field(h, kSlfcOffExponent, b.material.exponent);
-  common::put_field(h, kSlfcOffRoughness, b.material.roughness);
-  common::put_field(h, kSlfcOffF0, b.material.f0);
   common::put_field(h, kSlfcOffClusters, std::uint32_t(set.cluster_count));
   common::put_field(h, kSlfcOffComponents, std::uint32_t(set.component_count));
   common::put_field(h, kSlfcOffMeshPath, std::uint16_t(slf.mesh_path.size()));
   common::put_field(h, kSlfcOffProbeName, std::uint16_t(slf.probe_name.size()));
   common::put_field(h, kSlfcOffPayloadChecksum, common::fnv1a(body.data(), body.size()));
-  common::put_field(h, kSlfcOffProbeHash, b.probe_hash);
   common::seal_header(h);
   common::AtomicFile file(path);
   file.write(h.data(), h.size());
@@ -182,28 +164,8 @@ CompressedSlf read_slfc(const std::filesystem::path& path) {
   const common::VersionedHeader& h = f.header;
   CompressedSlf slf;
   prt::SlfShape& b = slf.bake;
-  b.atlas_width =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfcOffWidth), 1u << 30));
-  b.atlas_height =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfcOffHeight), 1u << 30));
-  b.grid.azimuth =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfcOffAzimuth), 1u << 30));
-  b.grid.elevation = int(
-      std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfcOffElevation), 1u << 30));
-  b.spp = int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfcOffSpp), 1u << 30));
-  b.bounces =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfcOffBounces), 1u << 30));
-  b.material.kind = prt::MaterialKind(common::get_field<std::uint32_t>(h, kSlfcOffKind));
-  b.material.masking = prt::Masking(common::get_field<std::uint32_t>(h, kSlfcOffMasking));
+  prt::get_slf_settings(h, b);
   b.rows = common::get_field<std::uint64_t>(h, kSlfcOffRows);
-  b.mesh_hash = common::get_field<std::uint64_t>(h, kSlfcOffMeshHash);
-  for (int c = 0; c < 3; ++c)
-    b.material.albedo[c] = common::get_field<float>(h, kSlfcOffAlbedo + 4 * c);
-  b.material.specular = common::get_field<float>(h, kSlfcOffSpecular);
-  b.material.exponent = common::get_field<float>(h, kSlfcOffExponent);
-  b.material.roughness = common::get_field<float>(h, kSlfcOffRoughness);
-  b.material.f0 = common::get_field<float>(h, kSlfcOffF0);
-  b.probe_hash = common::get_field<std::uint64_t>(h, kSlfcOffProbeHash);
   const std::uint64_t clusters = common::get_field<std::uint32_t>(h, kSlfcOffClusters);
   const std::uint64_t components = common::get_field<std::uint32_t>(h, kSlfcOffComponents);
   const std::size_t path_bytes = common::get_field<std::uint16_t>(h, kSlfcOffMeshPath);

@@ -45,8 +45,9 @@ constexpr std::size_t kSlfOffWidth = 16, kSlfOffHeight = 20, kSlfOffAzimuth = 24
 constexpr int kMaxSpp = 65536;
 constexpr float kSlfMaxRadiance = 1e20f;
 
-common::VersionedHeader encode_slf_header(const SlfShape& s, std::uint64_t payload_checksum) {
-  common::VersionedHeader h = common::begin_header(kSlfFormat);
+}  // namespace
+
+void put_slf_settings(common::VersionedHeader& h, const SlfShape& s) {
   common::put_field(h, kSlfOffWidth, std::uint32_t(s.atlas_width));
   common::put_field(h, kSlfOffHeight, std::uint32_t(s.atlas_height));
   common::put_field(h, kSlfOffAzimuth, std::uint32_t(s.grid.azimuth));
@@ -55,18 +56,47 @@ common::VersionedHeader encode_slf_header(const SlfShape& s, std::uint64_t paylo
   common::put_field(h, kSlfOffBounces, std::uint32_t(s.bounces));
   common::put_field(h, kSlfOffKind, std::uint32_t(s.material.kind));
   common::put_field(h, kSlfOffMasking, std::uint32_t(s.material.masking));
-  common::put_field(h, kSlfOffSeed, s.seed);
   common::put_field(h, kSlfOffMeshHash, s.mesh_hash);
   for (int c = 0; c < 3; ++c) common::put_field(h, kSlfOffAlbedo + 4 * c, s.material.albedo[c]);
   common::put_field(h, kSlfOffSpecular, s.material.specular);
   common::put_field(h, kSlfOffExponent, s.material.exponent);
   common::put_field(h, kSlfOffRoughness, s.material.roughness);
   common::put_field(h, kSlfOffF0, s.material.f0);
+  common::put_field(h, kSlfOffProbeHash, s.probe_hash);
+}
+
+void get_slf_settings(const common::VersionedHeader& h, SlfShape& s) {
+  const auto count = [&h](std::size_t offset) {
+    return int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, offset), 1u << 30));
+  };
+  s.atlas_width = count(kSlfOffWidth);
+  s.atlas_height = count(kSlfOffHeight);
+  s.grid.azimuth = count(kSlfOffAzimuth);
+  s.grid.elevation = count(kSlfOffElevation);
+  s.spp = count(kSlfOffSpp);
+  s.bounces = count(kSlfOffBounces);
+  s.material.kind = MaterialKind(common::get_field<std::uint32_t>(h, kSlfOffKind));
+  s.material.masking = Masking(common::get_field<std::uint32_t>(h, kSlfOffMasking));
+  s.mesh_hash = common::get_field<std::uint64_t>(h, kSlfOffMeshHash);
+  for (int c = 0; c < 3; ++c)
+    s.material.albedo[c] = common::get_field<float>(h, kSlfOffAlbedo + 4 * c);
+  s.material.specular = common::get_field<float>(h, kSlfOffSpecular);
+  s.material.exponent = common::get_field<float>(h, kSlfOffExponent);
+  s.material.roughness = common::get_field<float>(h, kSlfOffRoughness);
+  s.material.f0 = common::get_field<float>(h, kSlfOffF0);
+  s.probe_hash = common::get_field<std::uint64_t>(h, kSlfOffProbeHash);
+}
+
+namespace {
+
+common::VersionedHeader encode_slf_header(const SlfShape& s, std::uint64_t payload_checksum) {
+  common::VersionedHeader h = common::begin_header(kSlfFormat);
+  put_slf_settings(h, s);
+  common::put_field(h, kSlfOffSeed, s.seed);
   common::put_field(h, kSlfOffRows, std::uint32_t(s.rows));
   common::put_field(h, kSlfOffFirstRow, std::uint32_t(s.first_row));
   common::put_field(h, kSlfOffRowCount, std::uint32_t(s.row_count));
   common::put_field(h, kSlfOffPayloadChecksum, payload_checksum);
-  common::put_field(h, kSlfOffProbeHash, s.probe_hash);
   common::seal_header(h);
   return h;
 }
@@ -103,29 +133,11 @@ std::string shape_problem(const SlfShape& s) {
 
 SlfShape decode_slf_header(const common::VersionedHeader& h) {
   SlfShape s;
-  s.atlas_width = int(common::get_field<std::uint32_t>(h, kSlfOffWidth));
-  s.atlas_height = int(common::get_field<std::uint32_t>(h, kSlfOffHeight));
-  s.grid.azimuth =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfOffAzimuth), 1u << 30));
-  s.grid.elevation =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfOffElevation), 1u << 30));
-  s.spp = int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfOffSpp), 1u << 30));
-  s.bounces =
-      int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, kSlfOffBounces), 1u << 30));
-  s.material.kind = MaterialKind(common::get_field<std::uint32_t>(h, kSlfOffKind));
-  s.material.masking = Masking(common::get_field<std::uint32_t>(h, kSlfOffMasking));
+  get_slf_settings(h, s);
   s.seed = common::get_field<std::uint64_t>(h, kSlfOffSeed);
-  s.mesh_hash = common::get_field<std::uint64_t>(h, kSlfOffMeshHash);
-  for (int c = 0; c < 3; ++c)
-    s.material.albedo[c] = common::get_field<float>(h, kSlfOffAlbedo + 4 * c);
-  s.material.specular = common::get_field<float>(h, kSlfOffSpecular);
-  s.material.exponent = common::get_field<float>(h, kSlfOffExponent);
-  s.material.roughness = common::get_field<float>(h, kSlfOffRoughness);
-  s.material.f0 = common::get_field<float>(h, kSlfOffF0);
   s.rows = common::get_field<std::uint32_t>(h, kSlfOffRows);
   s.first_row = common::get_field<std::uint32_t>(h, kSlfOffFirstRow);
   s.row_count = common::get_field<std::uint32_t>(h, kSlfOffRowCount);
-  s.probe_hash = common::get_field<std::uint64_t>(h, kSlfOffProbeHash);
   return s;
 }
 

@@ -24,6 +24,7 @@
 // then rows stored x 3 Z W float32, then nothing.
 #pragma once
 
+#include "common/binary_file.h"
 #include "meshes/atlas.h"
 #include "meshes/mesh.h"
 #include "probes/probe.h"
@@ -82,6 +83,13 @@ struct SlfMatrix {
   std::vector<float> data;  // row_count x columns, row-major
   const float* row(std::uint64_t r) const { return data.data() + r * shape.columns(); }
 };
+
+// Both SLF files (.slf here, pipeline's .slfc) record the bake's settings in the same header
+// fields: bytes 16-47 (atlas size, grid, spp, bounces, material kind and masking), 56-91
+// (mesh hash, albedo, specular, exponent, roughness, f0) and 112 (probe hash). Reading
+// clamps counts to 2^30 so a hostile header cannot overflow an int; the caller validates.
+void put_slf_settings(common::VersionedHeader& header, const SlfShape& shape);
+void get_slf_settings(const common::VersionedHeader& header, SlfShape& shape);
 
 // The owned texels of the atlas in texel order: row r of the SLF matrix samples texel
 // slf_rows(atlas)[r] (y * width + x).
