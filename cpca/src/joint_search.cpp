@@ -223,6 +223,22 @@ std::vector<double> reconstruction_errors(const Eigen::Ref<const DataMatrix>& da
   return error;
 }
 
+// Makes a kept proposal the search's state and records the step.
+void keep_step(CompressedSet&& next, std::vector<double>&& next_error,
+               std::vector<std::uint32_t>&& next_pass, std::uint64_t drawn, std::uint64_t moves,
+               std::uint64_t swaps, double objective, CompressedSet& set,
+               std::vector<double>& error, std::vector<std::uint32_t>& pass_of,
+               JointSearchResult& r) {
+  set = std::move(next);
+  error = std::move(next_error);
+  pass_of = std::move(next_pass);
+  r.triangles_drawn = drawn;
+  r.vertex_moves += moves;
+  r.pass_swaps += swaps;
+  r.objective.push_back(objective);
+  ++r.steps;
+}
+
 // One step from (set, error, pass_of); returns false (and leaves them) unless J fell.
 bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const VertexTriangles& vt,
           const Eigen::VectorXf& norms, const JointSearchOptions& o, double mu, CompressedSet& set,
@@ -260,14 +276,8 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
   const double before = total_of(error) + mu * double(r.triangles_drawn);
   const double after = total_of(next_error) + mu * double(drawn);
   if (!(after < before)) return false;
-  set = std::move(next);
-  error = std::move(next_error);
-  pass_of = std::move(next_pass);
-  r.triangles_drawn = drawn;
-  r.vertex_moves += moves;
-  r.pass_swaps += swaps;
-  r.objective.push_back(after / double(data.rows()));
-  ++r.steps;
+  keep_step(std::move(next), std::move(next_error), std::move(next_pass), drawn, moves, swaps,
+            after / double(data.rows()), set, error, pass_of, r);
   return (before - after) / before >= o.threshold;
 }
 
@@ -441,14 +451,8 @@ bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
                           : feasible && (drawn < r.triangles_drawn || (drawn == r.triangles_drawn &&
                                                                        after_error < before_error));
   if (!better) return false;
-  set = std::move(next);
-  error = std::move(next_error);
-  pass_of = std::move(next_pass);
-  r.triangles_drawn = drawn;
-  r.vertex_moves += moves;
-  r.pass_swaps += swaps;
-  r.objective.push_back(after_error / double(data.rows()));
-  ++r.steps;
+  keep_step(std::move(next), std::move(next_error), std::move(next_pass), drawn, moves, swaps,
+            after_error / double(data.rows()), set, error, pass_of, r);
   return true;
 }
 
