@@ -61,6 +61,14 @@ for kind in diffuse glossy; do
     -o "$dir/seeds/prtc/$kind.prtc" --clusters 2 --pcs 1 --quiet >/dev/null
 done
 
+# A surface light field of the solid, baked (.slf, from the cache) and compressed (.slfc).
+mkdir -p "$dir/seeds/slf" "$dir/seeds/slfc"
+build/prtr slf "$dir/seeds/solid.obj" --probe /usr/share/blender/datafiles/studiolights/world/forest.exr \
+  --samples 24x24 --directions 4x2 --spp 1 --clusters 2 --pcs 1 --cache "$dir/seeds/slf-cache" \
+  -o "$dir/seeds/slfc/solid.slfc" --quiet >/dev/null
+cp "$dir"/seeds/slf-cache/*.slf "$dir/seeds/slf/"
+rm -rf "$dir/seeds/slf-cache"
+
 # HTTP request heads as prtr view receives them: pipelined, with a body, half-sent.
 mkdir -p "$dir/seeds/http"
 printf 'GET /frame?w=64&h=48&client=a&seq=1 HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nAccept: */*\r\n\r\nGET /api/info HTTP/1.1\r\nHost: localhost:8080\r\n\r\n' \
@@ -75,10 +83,12 @@ declare -A seeds=(
   [fuzz_mesh_obj]=mesh_obj [fuzz_mesh_ply]=mesh_ply [fuzz_mesh_off]=mesh_off
   [fuzz_mesh_stl]=mesh_stl [fuzz_mesh_3ds]=mesh_3ds [fuzz_mesh_gltf]=mesh_gltf [fuzz_mesh_glb]=mesh_glb
   [fuzz_probe_hdr]=probe_hdr [fuzz_probe_exr]=probe_exr [fuzz_http_request]=http
+  [fuzz_slf]=slf [fuzz_slf_resealed]=slf [fuzz_slfc]=slfc [fuzz_slfc_resealed]=slfc
 )
 targets=(fuzz_prtx fuzz_prtx_resealed fuzz_prtc fuzz_prtc_resealed fuzz_mesh_obj fuzz_mesh_ply
          fuzz_mesh_off fuzz_mesh_stl fuzz_mesh_3ds fuzz_mesh_gltf fuzz_mesh_glb fuzz_probe_hdr
-         fuzz_probe_exr fuzz_http_request)
+         fuzz_probe_exr fuzz_http_request fuzz_slf fuzz_slf_resealed fuzz_slfc
+         fuzz_slfc_resealed)
 # PRTR_FUZZ_SKIP: targets to leave out (names separated by spaces), e.g. one with an open
 # finding that is being fixed; each is named in the output, so a skip is never silent.
 if [[ -n ${PRTR_FUZZ_SKIP:-} ]]; then
