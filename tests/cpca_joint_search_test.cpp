@@ -167,6 +167,10 @@ TEST(JointSearch, OverdrawCapBoundsTheDraws) {
   EXPECT_THROW(cpca::compress_joint(x, o, g), std::invalid_argument);
 }
 
+// The epsilon search's constraint holds to the precision of its refits (power iteration to
+// 1e-6, on float bases), not to the last bit of an independently computed original.
+constexpr double kRefitTolerance = 1e-6;
+
 // patch-eps: the Average SE ends at or below (1 + eps) x original CPCA's (LBG + PCA, same K
 // and seed, compressed here independently) for several eps, and the draws it tracks are the
 // brute-force count. Where the start (patch-first) already meets the constraint the search
@@ -191,7 +195,7 @@ TEST(EpsilonSearch, MeetsTheErrorConstraint) {
     cpca::CompressReport report;
     const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
     EXPECT_EQ(set.method, cpca::ClusterMethod::kPatchEpsilon);
-    EXPECT_LE(report.error.average_squared_error, (1 + eps) * reference * (1 + 1e-9));
+    EXPECT_LE(report.error.average_squared_error, (1 + eps) * reference * (1 + kRefitTolerance));
     EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
     if (start.error.average_squared_error <= (1 + eps) * reference) {
       EXPECT_LE(search.triangles_drawn, start_draws);
@@ -208,7 +212,7 @@ TEST(EpsilonSearch, MeetsTheErrorConstraint) {
   cpca::JointSearchResult search;
   cpca::CompressReport report;
   const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
-  EXPECT_LE(report.error.average_squared_error, o.error_target * (1 + 1e-9));
+  EXPECT_LE(report.error.average_squared_error, o.error_target * (1 + kRefitTolerance));
   EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
 }
 
@@ -228,8 +232,11 @@ TEST(EpsilonSearch, HoldsWhenPatchesAreTooSmall) {
     cpca::CompressReport report;
     cpca::JointSearchResult search;
     const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);
+    // To the refits' tolerance: the fallback refits the original's clusters by power
+    // iteration to 1e-6, so its error may differ from LBG's own fit in the eighth digit (the
+    // sanitizer build's -O1 rounding showed 1e-8).
     EXPECT_LE(report.error.average_squared_error,
-              original.error.average_squared_error * (1 + 1e-9));
+              original.error.average_squared_error * (1 + kRefitTolerance));
     EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
   }
 }
