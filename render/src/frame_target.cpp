@@ -49,6 +49,8 @@ Image FrameTarget::read() const {
 }
 
 void FrameTarget::read(Image& image) const {
+  // An unbound target would read the default framebuffer: whatever the context last showed.
+  if (empty()) throw GlError("reading a frame: nothing rendered yet; call render() first");
   image.width = width_;
   image.height = height_;
   image.rgba.resize(std::size_t(image.width) * image.height * 4);

@@ -19,7 +19,7 @@ class FrameTarget {
   // `half`: RGBA16F colour instead of RGBA32F (a change reallocates).
   void bind(int width, int height, bool half = false);
   bool empty() const { return fbo_ == 0; }
-  // The colour buffer, row 0 at the top.
+  // The colour buffer, row 0 at the top. GlError before the first bind (nothing rendered).
   Image read() const;
   // The same into `into`, whose storage is reused when it is large enough: a fresh 2 x 2
   // supersampled frame is 77 MB, and zeroing and faulting it in cost more than the read.

@@ -213,8 +213,6 @@ Image Renderer::read_image() const {
 }
 
 void Renderer::read_image(Image& into) const {
-  if (impl_->target.empty())
-    throw GlError("Renderer::read_image: nothing rendered yet; call render() first");
   impl_->target.read(into);
 }
 

@@ -537,8 +537,6 @@ Image SlfRenderer::read_image() const {
 }
 
 void SlfRenderer::read_image(Image& into) const {
-  if (impl_->target.empty())
-    throw GlError("SlfRenderer::read_image: nothing rendered yet; call render() first");
   impl_->target.read(into);
 }
 
