@@ -57,9 +57,6 @@ supp=$PWD/tests/lsan_mesa.supp
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
 export LSAN_OPTIONS=suppressions=$supp:print_suppressions=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
-# cli_test's numeric-flag sweep only parses flags (the Release suite runs it); here its ~200
-# process starts, each paying ASan's start-up over 275 libraries, would cost minutes.
-export PRTR_CLI_SWEEP=0
 status=0
 (cd "$dir" && ctest --output-on-failure -j "$jobs" "$@") || status=$?
 done_at=$(date +%s)

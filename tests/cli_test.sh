@@ -42,11 +42,9 @@ run mesh a.obj --bogus; expect_code 2; check "unknown flag exits 2" $?
 # Every numeric flag of every command, read off --help: an empty value, a negative or
 # unparsable one and one past any range are usage errors that name the flag, and no message
 # holds a number longer than 15 digits (CLI11's own ranges printed DBL_MAX in full). Each flag
-# gets the empty value (which CLI11 alone would read as 0) and one of the other four in turn,
-# so every kind meets a quarter of the flags: a process start costs about half a second
-# (OpenImageIO's dependencies), and five per flag made this the suite's longest test.
-# The sanitizer run (scripts/sanitize.sh) sets PRTR_CLI_SWEEP=0: the sweep only parses flags,
-# and its ~200 process starts cost several minutes there.
+# gets every value: the empty one (which CLI11 alone would read as 0) and the other four. A
+# process start is a few milliseconds (image libraries load only when an image is touched,
+# common/image_codec.h). PRTR_CLI_SWEEP=0 skips the sweep.
 numeric_flags=0
 others=("-1" "abc" "1e400" "99999999999999999999999")
 subcommands=(bake compress merge mesh probe info render relight overdraw view gl-info slf path-trace compare)
@@ -54,7 +52,7 @@ subcommands=(bake compress merge mesh probe info render relight overdraw view gl
 for sub in "${subcommands[@]}"; do
   while read -r flag; do
     numeric_flags=$((numeric_flags + 1))
-    for bad in "" "${others[numeric_flags % 4]}"; do
+    for bad in "" "${others[@]}"; do
       run "$sub" "$flag" "$bad"
       # "-1" is a valid value of flags whose range holds it (angles, exposure, weld
       # tolerance): the flag is then accepted and only the missing arguments are reported.
@@ -68,6 +66,22 @@ for sub in "${subcommands[@]}"; do
   done < <("$prtr" "$sub" --help 2>/dev/null | grep -oE '^ +(-[a-z], ?)?--[a-z0-9-]+ (INT|UINT|FLOAT)' | grep -oE -- '--[a-z0-9-]+')
 done
 ((numeric_flags > 40 || ${#subcommands[@]} == 0)); check "numeric flags found in --help: $numeric_flags" $?
+
+# Image I/O lives in a module loaded on first use: prtr itself links no OpenImageIO, commands
+# that touch no image run without the module, and one that needs it says what is missing.
+if command -v readelf >/dev/null; then
+  ! readelf -d "$prtr" | grep -q 'NEEDED.*OpenImageIO'; check "prtr links no OpenImageIO" $?
+else
+  skip "prtr links no OpenImageIO (no readelf)"
+fi
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$tmp/tri.obj"
+out=$(PRTR_IMAGE_MODULE=/nonexistent/libprtr_oiio.so "$prtr" mesh "$tmp/tri.obj" 2>&1); code=$?
+expect_code 0; check "a command without images runs without the image module" $?
+: >"$tmp/missing_module.exr"
+out=$(PRTR_IMAGE_MODULE=/nonexistent/libprtr_oiio.so "$prtr" probe "$tmp/missing_module.exr" 2>&1)
+code=$?
+expect_code 1 && [[ $out == *"image module /nonexistent/libprtr_oiio.so"*PRTR_IMAGE_MODULE* ]]
+check "a missing image module exits 1 naming it and the fix" $?
 
 # Failures name the input.
 run mesh "$tmp/missing.obj"; expect_code 1 && [[ $err == *missing.obj* ]]; check "missing mesh exits 1 naming it" $?

@@ -5,9 +5,9 @@
 // and his Light Probe Image Gallery; the orientation used here is the one in probes/load.h.
 #include "probes/load.h"
 
+#include "common/image_codec.h"
 #include "exr_guard.h"
 
-#include <OpenImageIO/imageio.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -80,9 +80,9 @@ float srgb_to_linear(float c) {
   return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
 }
 
-Encoding encoding_of(const OIIO::ImageSpec& spec, float* gamma) {
-  const std::string space = lower(spec.get_string_attribute("oiio:ColorSpace"));
-  *gamma = spec.get_float_attribute("oiio:Gamma", 1.0f);
+Encoding encoding_of(const common::ImageHeader& header, float* gamma) {
+  const std::string space = lower(header.color_space);
+  *gamma = header.gamma;
   if (space == "srgb") return Encoding::kSrgb;
   if (space.rfind("gammacorrected", 0) == 0) {
     if (*gamma == 1.0f) {  // OpenImageIO spells the exponent in the name, e.g. "2.2"
@@ -93,7 +93,7 @@ Encoding encoding_of(const OIIO::ImageSpec& spec, float* gamma) {
   }
   // No colour space named: integer images are display-encoded by convention (sRGB), float
   // images (EXR, HDR) hold linear radiance.
-  if (space.empty() && !spec.format.is_floating_point()) return Encoding::kSrgb;
+  if (space.empty() && !header.floating_point) return Encoding::kSrgb;
   return Encoding::kLinear;
 }
 
@@ -164,9 +164,9 @@ std::uintmax_t check_file(const std::filesystem::path& path) {
 }
 
 // The spec checks made before anything is sized from the header.
-void check_spec(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
+void check_spec(const std::filesystem::path& path, const common::ImageHeader& spec,
                 std::uintmax_t file_size) {
-  const int w = spec.width, h = spec.height, channels = spec.nchannels;
+  const int w = spec.width, h = spec.height, channels = spec.channels;
   const std::string size = std::to_string(w) + "x" + std::to_string(h);
   if (w <= 0 || h <= 0) fail(path, "empty image (" + size + ")");
   if (spec.depth > 1 || spec.deep) fail(path, "volume and deep images are not environment maps");
@@ -198,7 +198,7 @@ void check_spec(const std::filesystem::path& path, const OIIO::ImageSpec& spec,
 
 // Float texels to linear RGB: grey to RGB, NaN/Inf refused, negatives clamped, decoded.
 void decode(const std::filesystem::path& path, const std::vector<float>& raw, int used,
-            const OIIO::ImageSpec& spec, Image& image) {
+            const common::ImageHeader& spec, Image& image) {
   float gamma = 1.0f;
   const Encoding encoding = encoding_of(spec, &gamma);
   const std::size_t texels = std::size_t(image.width) * std::size_t(image.height);
@@ -232,19 +232,20 @@ void decode(const std::filesystem::path& path, const std::vector<float>& raw, in
 
 Image read_image(const std::filesystem::path& path) {
   const std::uintmax_t file_size = check_file(path);
-  std::unique_ptr<OIIO::ImageInput> in;
+  std::unique_ptr<common::ImageFile> in;
+  std::string error;
   try {
-    in = OIIO::ImageInput::open(path.string());
+    in = common::image_codec().open(path.string(), &error);
   } catch (const std::bad_alloc&) {
     fail(path, "its header asks for more memory than there is; the file is damaged, re-export it");
   }
-  if (!in) fail(path, "cannot be read as an image: " + OIIO::geterror());
-  const OIIO::ImageSpec spec = in->spec();
+  if (!in) fail(path, "cannot be read as an image: " + error);
+  const common::ImageHeader& spec = in->header();
   check_spec(path, spec, file_size);
   Image image;
   image.width = spec.width;
   image.height = spec.height;
-  image.channels = spec.nchannels;
+  image.channels = spec.channels;
   // Read the first three channels (or the only one) as float.
   const int used = image.channels == 1 ? 1 : 3;
   const std::string too_large = std::to_string(image.width) + "x" + std::to_string(image.height) +
@@ -252,17 +253,15 @@ Image read_image(const std::filesystem::path& path) {
   std::vector<float> raw;
   try {
     raw.resize(std::size_t(image.width) * std::size_t(image.height) * std::size_t(used));
-    if (!in->read_image(0, 0, 0, used, OIIO::TypeDesc::FLOAT, raw.data())) {
-      fail(path,
-           "cannot read the pixels: " + in->geterror() + "; the file is damaged, re-export it");
+    if (!in->read(used, raw.data(), &error)) {
+      fail(path, "cannot read the pixels: " + error + "; the file is damaged, re-export it");
     }
   } catch (const std::bad_alloc&) {
     fail(path, too_large);
   } catch (const std::length_error&) {
     fail(path, too_large);
   }
-  image.format = in->format_name();
-  in->close();
+  image.format = spec.format;
   decode(path, raw, used, spec, image);
   return image;
 }

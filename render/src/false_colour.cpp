@@ -5,11 +5,8 @@
 #include "render/image.h"
 
 #include "common/atomic_file.h"
+#include "common/image_codec.h"
 #include "common/output_path.h"
-
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 
 #include <Eigen/Geometry>
 
@@ -235,14 +232,9 @@ void fill_rect(Picture& picture, Rect rect, const Colour8& colour) {
 
 bool draw_text(Picture& picture, int x, int y, const std::string& text, int size,
                const Colour8& colour) {
-  OIIO::ImageSpec spec(picture.width, picture.height, 3, OIIO::TypeDesc::UINT8);
-  OIIO::ImageBuf buffer(spec, picture.rgb.data());  // wraps the picture's pixels
   const float c[3] = {colour[0] / 255.f, colour[1] / 255.f, colour[2] / 255.f};
-  if (!OIIO::ImageBufAlgo::render_text(buffer, x, y, text, size, "DejaVuSans", c)) {
-    // Retry with OpenImageIO's own default before giving up.
-    if (!OIIO::ImageBufAlgo::render_text(buffer, x, y, text, size, "", c)) return false;
-  }
-  return true;
+  return common::image_codec().draw_text(picture.rgb.data(), picture.width, picture.height, x, y,
+                                         text, size, c);
 }
 
 void write_picture_png(const fs::path& path, const Picture& picture) {

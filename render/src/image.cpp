@@ -1,9 +1,8 @@
 #include "render/image.h"
 
 #include "common/atomic_file.h"
+#include "common/image_codec.h"
 #include "common/output_path.h"
-
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,10 +17,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Writes through OpenImageIO to a hidden temporary name with the target's extension (OIIO
-// picks the format from it), then renames; the temporary is removed on any failure.
-void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const void* data,
-                      const char* what, OIIO::TypeDesc data_type) {
+// Writes through the image codec to a hidden temporary name with the target's extension
+// (which picks the format), then renames; the temporary is removed on any failure.
+void write_atomically(const fs::path& path, const common::ImageWriteSpec& spec, const void* data,
+                      const char* what) {
   const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
   if (!fs::is_directory(dir))
     throw ImageError(std::string("cannot write ") + what + " " + path.string() + ": directory " +
@@ -33,11 +32,8 @@ void write_atomically(const fs::path& path, const OIIO::ImageSpec& spec, const v
     fs::remove(temp, ec);
     throw ImageError(std::string("cannot write ") + what + " " + path.string() + ": " + why);
   };
-  auto out = OIIO::ImageOutput::create(temp.string());
-  if (!out) fail("no OpenImageIO writer for extension '" + path.extension().string() + "'");
-  if (!out->open(temp.string(), spec)) fail(out->geterror());
-  if (!out->write_image(data_type, data)) fail(out->geterror());
-  if (!out->close()) fail(out->geterror());
+  std::string error;
+  if (!common::image_codec().write(temp.string(), spec, data, &error)) fail(error);
   if (const std::string problem = common::output_target_problem(path); !problem.empty())
     fail(problem + "; write to another path");
   std::error_code ec;
@@ -69,12 +65,15 @@ void write_exr(const std::filesystem::path& path, const Image& image, ExrPixels 
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
     throw ImageError("cannot write " + path.string() + ": the image is empty or mis-sized");
   const bool half = pixels == ExrPixels::kHalf;
-  OIIO::ImageSpec spec(image.width, image.height, 4,
-                       half ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
-  spec.channelnames = {"R", "G", "B", "A"};
+  common::ImageWriteSpec spec;
+  spec.width = image.width;
+  spec.height = image.height;
+  spec.channels = 4;
+  spec.stored = half ? common::StoredPixels::kHalf : common::StoredPixels::kFloat;
+  spec.channel_names = {"R", "G", "B", "A"};
   spec.alpha_channel = 3;
-  spec.attribute("compression", half ? "piz" : "zip");
-  write_atomically(path, spec, image.rgba.data(), "EXR", OIIO::TypeDesc::FLOAT);
+  spec.compression = half ? "piz" : "zip";
+  write_atomically(path, spec, image.rgba.data(), "EXR");
 }
 
 void write_png(const std::filesystem::path& path, const Image& image, double exposure) {
@@ -89,27 +88,32 @@ void write_rgb8_png(const std::filesystem::path& path, int width, int height,
   if (width < 1 || height < 1 || rgb.size() != std::size_t(width) * std::size_t(height) * 3)
     throw ImageError(std::string("cannot write ") + what + " " + path.string() +
                      ": the image is empty or mis-sized");
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("png:compressionLevel", 1);
-  write_atomically(path, spec, rgb.data(), what, OIIO::TypeDesc::UINT8);
+  common::ImageWriteSpec spec;
+  spec.width = width;
+  spec.height = height;
+  spec.channels = 3;
+  spec.stored = common::StoredPixels::kUint8;
+  spec.png_compression_level = 1;
+  write_atomically(path, spec, rgb.data(), what);
 }
 
 Image read_image(const std::filesystem::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
+  std::string error;
+  const auto in = common::image_codec().open(path.string(), &error);
   if (!in)
-    throw ImageError("cannot read image " + path.string() + ": " + OIIO::geterror() +
+    throw ImageError("cannot read image " + path.string() + ": " + error +
                      " (check the path and that it is an image file)");
-  const OIIO::ImageSpec& spec = in->spec();
+  const common::ImageHeader& spec = in->header();
   Image image;
   image.width = spec.width;
   image.height = spec.height;
-  std::vector<float> all(std::size_t(spec.width) * spec.height * spec.nchannels);
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-    throw ImageError("cannot read image " + path.string() + ": " + in->geterror());
+  std::vector<float> all(std::size_t(spec.width) * spec.height * spec.channels);
+  if (!in->read(spec.channels, all.data(), &error))
+    throw ImageError("cannot read image " + path.string() + ": " + error);
   image.rgba.assign(std::size_t(spec.width) * spec.height * 4, 1.f);
   for (std::size_t p = 0; p < std::size_t(spec.width) * spec.height; ++p)
-    for (int c = 0; c < std::min(4, spec.nchannels); ++c)
-      image.rgba[p * 4 + c] = all[p * spec.nchannels + c];
+    for (int c = 0; c < std::min(4, spec.channels); ++c)
+      image.rgba[p * 4 + c] = all[p * spec.channels + c];
   return image;
 }
 
