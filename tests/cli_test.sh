@@ -486,6 +486,13 @@ if [[ -f $forest ]]; then
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 8 --height 6 --spp 1 -o "$tmp/pt2.exr" -q
   run compare "$tmp/slf.exr" "$tmp/pt2.exr"
   expect_code 1 && [[ $err == *"differ in size"* ]]; check "compare: images of different sizes are refused naming both" $?
+  # --erode leaves the outline out: fewer pixels, and none at all when the band is wider
+  # than the mesh's image.
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --json; all=$(jget - /pixels <<<"$out")
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --json --erode 1; inner=$(jget - /pixels <<<"$out")
+  expect_code 0 && ((inner > 0 && inner < all)); check "compare --erode 1 compares fewer pixels ($inner of $all)" $?
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --erode 1000
+  expect_code 1 && [[ $err == *"inside the outline"* ]]; check "compare --erode wider than the mesh fails saying so" $?
 fi
 
 echo "cli: $passed passed, $failed failed"

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <vector>
 
 namespace {
@@ -219,4 +220,47 @@ TEST(ImageDifference, RefusesDifferentSizesNoCoverageAndNonFiniteValues) {
   render::Image nan = a;
   nan.pixel(0, 0)[1] = std::nanf("");
   EXPECT_THROW(render::image_difference(nan, a), std::invalid_argument);
+}
+
+// Erosion against a brute-force count: a pixel stays when every pixel of its (2 r + 1)^2
+// square lies inside the image and is covered in both, on random coverage masks.
+TEST(ImageDifference, ErodeKeepsExactlyThePixelsWhoseSquareIsCovered) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(0.f, 1.f);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int w = 5 + trial % 7, h = 4 + trial % 5, r = 1 + trial % 3;
+    render::Image reference = flat_image(w, h, 1.f, 1.f), image = reference;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (unit(rng) < 0.08f) reference.pixel(x, y)[3] = 0.f;
+        if (unit(rng) < 0.08f) image.pixel(x, y)[3] = 0.f;
+        image.pixel(x, y)[0] = 1.f + float(x + w * y);  // each pixel's own error
+      }
+    std::uint64_t count = 0;
+    double max_abs = 0.0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        bool inside = true;
+        for (int dy = -r; dy <= r; ++dy)
+          for (int dx = -r; dx <= r; ++dx) {
+            const int u = x + dx, v = y + dy;
+            inside = inside && u >= 0 && v >= 0 && u < w && v < h && image.pixel(u, v)[3] > 0.5f &&
+                     reference.pixel(u, v)[3] > 0.5f;
+          }
+        if (inside) {
+          ++count;
+          max_abs = std::max(max_abs, double(x + w * y));
+        }
+      }
+    if (count == 0) {
+      EXPECT_THROW(render::image_difference(image, reference, 0.999f, r), std::invalid_argument);
+      continue;
+    }
+    const render::ImageDifference d = render::image_difference(image, reference, 0.999f, r);
+    EXPECT_EQ(d.pixels, count) << "trial " << trial;
+    EXPECT_NEAR(d.max_abs, max_abs, 1e-9) << "trial " << trial;
+  }
+  EXPECT_THROW(
+      render::image_difference(flat_image(4, 4, 1.f, 1.f), flat_image(4, 4, 1.f, 1.f), 0.999f, -1),
+      std::invalid_argument);
 }

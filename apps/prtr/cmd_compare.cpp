@@ -17,6 +17,7 @@ namespace cmd_compare {
 struct Options {
   std::string image, reference;
   double coverage = 0.999;
+  int erode = 0;
   bool json = false;
 };
 
@@ -26,6 +27,10 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_checked_option(cmd, "--coverage", o.coverage,
                      "Compare pixels whose alpha is at least this in both (0: every pixel)",
                      number_in(0.0, 1.0));
+  add_checked_option(cmd, "--erode", o.erode,
+                     "Compare only pixels at least this many pixels inside the covered region "
+                     "of both (0: every covered pixel; silhouettes left out)",
+                     integer_in(0, 1024));
   cmd->add_flag("--json", o.json, "Print the figures as one JSON line");
 }
 
@@ -34,7 +39,7 @@ void run(const Options& o, CLI::App*) {
   const render::Image reference = render::read_image(o.reference);
   render::ImageDifference d;
   try {
-    d = render::image_difference(image, reference, float(o.coverage));
+    d = render::image_difference(image, reference, float(o.coverage), o.erode);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(o.image + " against " + o.reference + ": " + e.what());
   }

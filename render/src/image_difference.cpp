@@ -4,10 +4,40 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace render {
 
-ImageDifference image_difference(const Image& image, const Image& reference, float coverage) {
+namespace {
+
+// The mask eroded by a (2 r + 1)^2 square: separable, a running count of uncovered pixels
+// along each row, then each column (outside the image counts as uncovered).
+std::vector<char> erode_mask(const std::vector<char>& mask, int width, int height, int r) {
+  auto pass = [r](const std::vector<char>& in, int n, int lines, std::size_t step,
+                  std::size_t line_step) {
+    std::vector<char> out(in.size(), 0);
+    for (int line = 0; line < lines; ++line) {
+      const std::size_t base = std::size_t(line) * line_step;
+      auto at = [&](int i) { return i >= 0 && i < n && in[base + std::size_t(i) * step]; };
+      int holes = 0;  // uncovered pixels in [i - r, i + r]
+      for (int i = -r; i <= r; ++i) holes += !at(i);
+      for (int i = 0; i < n; ++i) {
+        out[base + std::size_t(i) * step] = holes == 0;
+        holes += !at(i + r + 1);
+        holes -= !at(i - r);
+      }
+    }
+    return out;
+  };
+  const std::vector<char> rows = pass(mask, width, height, 1, std::size_t(width));
+  return pass(rows, height, width, std::size_t(width), 1);
+}
+
+}  // namespace
+
+ImageDifference image_difference(const Image& image, const Image& reference, float coverage,
+                                 int erode) {
+  if (erode < 0) throw std::invalid_argument("erode must be >= 0");
   if (image.width != reference.width || image.height != reference.height) {
     std::string why = "the images differ in size: ";
     why += std::to_string(image.width) + " x " + std::to_string(image.height) + " against ";
@@ -17,10 +47,14 @@ ImageDifference image_difference(const Image& image, const Image& reference, flo
   ImageDifference e;
   double squared = 0.0, reference_squared = 0.0, absolute = 0.0;
   const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
+  std::vector<char> compared(n);
+  for (std::size_t i = 0; i < n; ++i)
+    compared[i] = image.rgba[4 * i + 3] >= coverage && reference.rgba[4 * i + 3] >= coverage;
+  if (erode > 0) compared = erode_mask(compared, image.width, image.height, erode);
   for (std::size_t i = 0; i < n; ++i) {
     const float* a = image.rgba.data() + 4 * i;
     const float* r = reference.rgba.data() + 4 * i;
-    if (a[3] < coverage || r[3] < coverage) continue;
+    if (!compared[i]) continue;
     for (int c = 0; c < 3; ++c) {
       if (!std::isfinite(a[c]) || !std::isfinite(r[c]))
         throw std::invalid_argument("pixel " + std::to_string(i % image.width) + ", " +
@@ -34,7 +68,10 @@ ImageDifference image_difference(const Image& image, const Image& reference, flo
     ++e.pixels;
   }
   if (e.pixels == 0)
-    throw std::invalid_argument("no pixel is covered in both images (alpha below coverage)");
+    throw std::invalid_argument(erode > 0 ? "no pixel is covered in both images " +
+                                                std::to_string(erode) + " pixels inside the outline"
+                                          : std::string("no pixel is covered in both images "
+                                                        "(alpha below coverage)"));
   const double values = 3.0 * double(e.pixels);
   e.rmse = std::sqrt(squared / values);
   e.mean_abs = absolute / values;

@@ -17,8 +17,11 @@ struct ImageDifference {
 };
 
 // Throws std::invalid_argument when the sizes differ, nothing is compared or a compared
-// value is not finite.
+// value is not finite. erode > 0 compares only pixels whose whole (2 erode + 1)^2 square is
+// covered in both: silhouette pixels, which a sub-pixel difference in where the edge falls
+// (or a view-dependent effect that lives only at grazing angles) changes completely, then
+// drop out, and what remains measures the shading inside the outline.
 ImageDifference image_difference(const Image& image, const Image& reference,
-                                 float coverage = 0.999f);
+                                 float coverage = 0.999f, int erode = 0);
 
 }  // namespace render
