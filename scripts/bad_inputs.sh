@@ -135,6 +135,10 @@ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 20000 +X 40000\n' >huge.hdr
 add huge.hdr probe "53-byte HDR claiming 40000 x 20000"
 printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1000000000 +X 2000000000\n' >huger.hdr
 add huger.hdr probe "HDR claiming 2e9 x 1e9"
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 8\n\002\002\000\010'; printf '\211\007'; } >overrun.hdr
+add overrun.hdr probe "HDR whose first run-length run is 9 bytes long in an 8-pixel line"
+printf '#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 2 +X 4\n' >xyze.hdr
+add xyze.hdr probe "HDR of CIE XYZ pixels (XYZE)"
 { printf '\x76\x2f\x31\x01'; le V 2; printf 'comments\0string\0'; le V 1900000000; head -c 1000 /dev/zero | tr '\0' x; } >attribute.exr
 add attribute.exr probe "1 KB EXR whose string attribute claims 1.9 GB"
 { printf '\x76\x2f\x31\x01'; le V 2; printf 'owner\0string\0'; le l -5; printf 'abc'; } >negative.exr
@@ -199,8 +203,8 @@ measure=()
   echo "the script from bytes, then given to the command shown. Exit codes: 0 success, 1 failure"
   echo "(the message names the file and says what to do), 2 usage error. A crash would show as"
   echo "128 + the signal. Seconds and peak memory (MB) are for the whole command, so they are"
-  echo "mostly process start-up (loading OpenImageIO, Embree and Mesa): what matters is that no"
-  echo "row stands out."
+  echo "mostly process start-up (OpenImageIO and Mesa load only when an image or a GL context is"
+  echo "needed, common/image_codec.h): what matters is that no row stands out."
   echo
   echo "Size limits behind these answers: mesh readers check every count a header claims"
   echo "against the bytes left in the file before allocating; probe loading refuses an image"
@@ -210,13 +214,16 @@ measure=()
   echo "offset table longer than the file) before OpenEXR reads it (\`probes/src/exr_guard.cpp\`)."
   echo
   echo "Which reader does what: OFF and PLY are read by our own strict readers"
-  echo "(\`meshes/src/read_strict.cpp\`; OpenMesh's OFF and PLY readers size buffers from"
+  echo "(\`meshes/src/read_strict.cpp\` and \`read_ply.cpp\`; OpenMesh's OFF and PLY readers size buffers from"
   echo "unchecked counts and read values they never set after a parse error, which no guard in"
   echo "front of them can fix), and so is STL (binary or ASCII, decided by the file's size). OBJ"
   echo "still goes through OpenMesh, behind a strict pre-pass over its lines and face records."
-  echo "glTF 2.0 and 3DS go through Assimp behind \`meshes/src/asset_guard.cpp\`, which checks"
+  echo "glTF 2.0 and 3DS go through Assimp behind \`meshes/src/asset_guard.cpp\` and"
+  echo "\`asset_guard_3ds.cpp\`, which check"
   echo "every size, URI and nesting depth Assimp would trust (the table of guards is in"
-  echo "docs/ARCHITECTURE.md, \"Mesh assets\"). Images go through OpenImageIO behind the checks above."
+  echo "docs/ARCHITECTURE.md, \"Mesh assets\"). Radiance .hdr probes are read by our own bounded"
+  echo "reader (\`probes/src/rgbe_file.cpp\`: header size, resolution range, every run checked"
+  echo "against its line); other images go through OpenImageIO behind the checks above."
   echo
   echo "The same loaders are fuzzed by \`scripts/fuzz.sh [seconds]\` (libFuzzer, ASan, UBSan;"
   echo "targets in \`fuzz/\`) and the whole test suite runs under ASan, UBSan and LSan with"

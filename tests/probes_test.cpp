@@ -481,6 +481,98 @@ TEST(Load, HdrRoundTrip) {
   }
 }
 
+// The Radiance reader is ours (probes/src/rgbe_file.h); OpenImageIO, reading the same
+// files, is the oracle: bit-identical texels for run-length lines (width 8 and more, with
+// constant stretches so that runs occur) and flat ones (width below 8).
+std::vector<float> read_with_oiio(const fs::path& path, int* w, int* h) {
+  auto in = OIIO::ImageInput::open(path.string());
+  EXPECT_TRUE(in) << OIIO::geterror();
+  if (!in) return {};
+  *w = in->spec().width;
+  *h = in->spec().height;
+  std::vector<float> data(std::size_t(*w) * *h * 3);
+  EXPECT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, data.data()));
+  return data;
+}
+
+TEST(Load, HdrReaderMatchesOpenImageIOBitForBit) {
+  for (const auto& [w, h] : {std::pair{64, 32}, std::pair{4, 2}, std::pair{300, 150}}) {
+    std::vector<float> data = random_texels(w, h, unsigned(w), 0.0f, 2000.0f);
+    for (std::size_t i = 0; i < data.size() / 3; i += 7)  // constant stretches: runs
+      for (std::size_t j = i; j < std::min(data.size() / 3, i + 4); ++j)
+        for (int c = 0; c < 3; ++c) data[3 * j + c] = data[3 * i + c];
+    for (std::size_t i = 0; i < data.size(); i += 11) data[i] = 0.0f;  // zero exponents
+    const fs::path path = tmp_dir() / ("oracle" + std::to_string(w) + ".hdr");
+    write_image(path, w, h, 3, data);
+    int ow = 0, oh = 0;
+    const std::vector<float> oracle = read_with_oiio(path, &ow, &oh);
+    const Probe p = load_probe(path);
+    ASSERT_EQ(p.width(), ow);
+    ASSERT_EQ(p.height(), oh);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = (std::size_t(y) * w + x) * 3;
+        ASSERT_EQ(p.texel(x, y), Rgb(oracle[i], oracle[i + 1], oracle[i + 2]))
+            << w << " x " << h << " at " << x << ", " << y;
+      }
+  }
+}
+
+namespace {
+
+std::string radiance_header(const std::string& resolution) {
+  return "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\nEXPOSURE=1.0\n\n" + resolution + "\n";
+}
+
+// One new-style run-length line of width 8 for R = G = B = 128, E = e (each channel one
+// run of 8), i.e. every texel 128 x 2^(e - 136).
+std::string rle_line(unsigned char e) {
+  return std::string{2, 2, 0, 8} + std::string{char(128 + 8), char(128)} +
+         std::string{char(128 + 8), char(128)} + std::string{char(128 + 8), char(128)} +
+         std::string{char(128 + 8), char(e)};
+}
+
+}  // namespace
+
+TEST(Load, HdrReaderDecodesHandWrittenLines) {
+  // "+Y 4": the bottom row comes first. Rows written with E 139, 138, 137, 136 read back
+  // top to bottom as 128, 256, 512, 1024.
+  const fs::path flipped = tmp_dir() / "flipped.hdr";
+  std::ofstream(flipped, std::ios::binary) << radiance_header("+Y 4 +X 8") << rle_line(139)
+                                           << rle_line(138) << rle_line(137) << rle_line(136);
+  const Probe p = load_probe(flipped, {Layout::kLatLong});
+  for (int y = 0; y < 4; ++y) EXPECT_EQ(p.texel(5, y), Rgb::Constant(128.0f * float(1 << y))) << y;
+  // The old scheme: a pixel, then (1, 1, 1, 3) repeats it 3 times; width 4 (flat lines).
+  const fs::path old = tmp_dir() / "old_rle.hdr";
+  std::string line = std::string{char(64), char(32), char(16), char(129)} + std::string{1, 1, 1, 3};
+  std::ofstream(old, std::ios::binary) << radiance_header("-Y 2 +X 4") << line << line;
+  const Probe q = load_probe(old, {Layout::kLatLong});
+  for (int x = 0; x < 4; ++x) EXPECT_EQ(q.texel(x, 1), Rgb(0.5f, 0.25f, 0.125f)) << x;
+}
+
+TEST(LoadErrors, DamagedHdrFilesNameTheCause) {
+  const auto message = [](const std::string& name, const std::string& bytes) {
+    const fs::path path = tmp_dir() / name;
+    std::ofstream(path, std::ios::binary) << bytes;
+    return error_of([&] { load_probe(path, {Layout::kLatLong}); });
+  };
+  std::string m = message("xyze.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_xyze\n\n-Y 2 +X 4\n");
+  EXPECT_NE(m.find("xyze.hdr"), std::string::npos) << m;
+  EXPECT_NE(m.find("32-bit_rle_xyze"), std::string::npos) << m;
+  m = message("transposed.hdr", radiance_header("+X 8 -Y 4"));
+  EXPECT_NE(m.find("resolution line"), std::string::npos) << m;
+  m = message("overrun.hdr", radiance_header("-Y 1 +X 8") + std::string{2, 2, 0, 8} +
+                                 std::string{char(128 + 9), 7});
+  EXPECT_NE(m.find("past the end of the line"), std::string::npos) << m;
+  m = message("cut.hdr", radiance_header("-Y 2 +X 8") + rle_line(136));
+  EXPECT_NE(m.find("scanline 1 of 2"), std::string::npos) << m;
+  EXPECT_NE(m.find("ends inside it"), std::string::npos) << m;
+  m = message("repeat_first.hdr", radiance_header("-Y 1 +X 4") + std::string{1, 1, 1, 3});
+  EXPECT_NE(m.find("before the line's first pixel"), std::string::npos) << m;
+  m = message("endless.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n" + std::string(70000, 'x'));
+  EXPECT_NE(m.find("runs past"), std::string::npos) << m;
+}
+
 TEST(Load, OneChannelIsGreyAndAlphaIsIgnored) {
   const int w = 16, h = 8;
   std::vector<float> grey(std::size_t(w) * h), rgba(std::size_t(w) * h * 4);

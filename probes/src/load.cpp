@@ -7,6 +7,7 @@
 
 #include "common/image_codec.h"
 #include "exr_guard.h"
+#include "rgbe_file.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -234,12 +235,18 @@ Image read_image(const std::filesystem::path& path) {
   const std::uintmax_t file_size = check_file(path);
   std::unique_ptr<common::ImageFile> in;
   std::string error;
-  try {
-    in = common::image_codec().open(path.string(), &error);
-  } catch (const std::bad_alloc&) {
-    fail(path, "its header asks for more memory than there is; the file is damaged, re-export it");
+  if (detail::is_rgbe(path)) {
+    in = detail::open_rgbe(path, &error);
+    if (!in) fail(path, error);
+  } else {
+    try {
+      in = common::image_codec().open(path.string(), &error);
+    } catch (const std::bad_alloc&) {
+      fail(path,
+           "its header asks for more memory than there is; the file is damaged, re-export it");
+    }
+    if (!in) fail(path, "cannot be read as an image: " + error);
   }
-  if (!in) fail(path, "cannot be read as an image: " + error);
   const common::ImageHeader& spec = in->header();
   check_spec(path, spec, file_size);
   Image image;
