@@ -10,7 +10,8 @@
 #
 # It unpacks bundle.tar.xz into a scratch folder, makes the inputs there (bundle_inputs: the
 # bunny subdivided 0, 1 and 2 times, baked with 64 samples and compressed, 256 x 8), runs
-# render_bench_portable on each mesh, then bake_bench at each thread count.
+# render_bench_portable on each mesh, then bake_bench at each thread count, then prtr view
+# end to end.
 set -uo pipefail
 bundle=$(cd "$(dirname "$0")" && pwd)
 res=$(mkdir -p "${1:?usage: run_gpu.sh RESULTS_DIR}" && cd "$1" && pwd)
@@ -71,6 +72,9 @@ cap() {  # cap MAX [RESERVE]: seconds for a step
 table() {
   python3 "$bundle/gpu_table.py" "$res/env.txt" "$res/render_bench.log" "$res/bake_bench.log" \
     "$res/inputs.log" >"$res/results.md" 2>>"$res/inputs.log"
+  if [[ -s $res/view.md ]]; then
+    { echo; echo "## prtr view end to end ($gl)"; echo; cat "$res/view.md"; } >>"$res/results.md"
+  fi
 }
 : >"$res/render_bench.log"
 : >"$res/bake_bench.log"
@@ -147,6 +151,33 @@ bake_runs() {
   done
 }
 bake_runs
+# prtr view on this machine's GL: the bunny under the bundled probe (a Radiance .hdr, which
+# prtr reads without OpenImageIO), baked here through its cache, then frames requested over
+# loopback at 1280 x 948 by view_timing.py (no browser here): where a frame's time goes.
+view_run() {
+  [[ -x $here/bin/prtr && -f $here/data/forest.hdr ]] || return 0
+  local limit log=$res/view_server.log url=""
+  limit=$(cap 120 30)
+  echo "== view (at $SECONDS s, limit $limit s)" | tee -a "$log"
+  timeout "$limit" "$here/bin/prtr" view "$here/data/bunny_x0.ply" --probe "$here/data/forest.hdr" \
+    --gl "$gl" --host 127.0.0.1 --port 0 --cache "$here/view_cache" -q >>"$log" 2>&1 &
+  local server=$!
+  for _ in $(seq 1 "$limit"); do
+    url=$(grep -o 'http://127.0.0.1:[0-9]*/' "$log" | head -1)
+    [[ -n $url ]] && break
+    kill -0 "$server" 2>/dev/null || break
+    sleep 1
+  done
+  if [[ -n $url ]]; then
+    timeout "$(cap 60 20)" python3 "$bundle/view_timing.py" "$url" --frames "${PRTR_GPU_VIEW_FRAMES:-100}" \
+      --size 1280x948 >"$res/view.md" 2>>"$log"
+    echo "== view timing exit $? at $SECONDS s" | tee -a "$log"
+  fi
+  kill "$server" 2>/dev/null
+  wait "$server" 2>/dev/null
+  table
+}
+[[ " $meshes " == *" bunny_x0 "* ]] && view_run
 # The two changes apart: constants as the device chooses, RGBA32F accumulation.
 [[ " $meshes " == *" bunny_x0 "* ]] && bench_run bunny_x0-rgba32f bunny_x0 50 --accumulation rgba32f
 # The largest mesh before the middle one: its 16-a-pass row is a target.
