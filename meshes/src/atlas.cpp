@@ -225,6 +225,7 @@ Atlas make_per_triangle_atlas(const Mesh& mesh, int width, int height) {
   pack(order, legs_unit, lo, width, height, &cells);
 
   Atlas atlas;
+  atlas.charts = AtlasCharts::kPerTriangle;
   atlas.width = width;
   atlas.height = height;
   atlas.uv.assign(3 * std::size_t(count), Eigen::Vector2f::Zero());

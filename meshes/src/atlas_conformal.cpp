@@ -291,6 +291,7 @@ Filled fill_texels(const Mesh& mesh, const std::vector<Layout>& layouts,
   Filled out;
   Atlas& atlas = out.atlas;
   const int charts = int(layouts.size());
+  atlas.charts = AtlasCharts::kConformal;
   atlas.width = width;
   atlas.height = height;
   atlas.uv.assign(3 * mesh.triangles.size(), Eigen::Vector2f::Zero());

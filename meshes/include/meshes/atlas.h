@@ -39,7 +39,8 @@ struct AtlasOptions {
 };
 
 struct Atlas {
-  int width = 0, height = 0;          // texels
+  AtlasCharts charts = AtlasCharts::kConformal;  // how it was cut (files record it)
+  int width = 0, height = 0;                     // texels
   std::vector<Eigen::Vector2f> uv{};  // 3 per triangle (corner 3 t + i), in [0, 1]^2; texel
                                       // x's centre is at (x + 0.5) / width
   // Per texel, row-major (y * width + x): the triangle whose lookups read it (-1: none) and
