@@ -399,7 +399,9 @@ AtlasFigures check_conformal_atlas(const Mesh& mesh, const Atlas& atlas, double 
   std::uniform_real_distribution<double> unit(0, 1);
   for (std::size_t t = 0; t < count; ++t) {
     const int chart = atlas.triangle_chart[t];
-    for (int k = 0; k < 12; ++k) {
+    // About 4 points per texel of the triangle, at least 12.
+    const int points = std::clamp(int(4 * std::max(texture[t], 0.0)), 12, 400);
+    for (int k = 0; k < points; ++k) {
       double u = unit(rng), v = unit(rng);
       if (u + v > 1) u = 1 - u, v = 1 - v;
       if (k < 3) u = k == 1, v = k == 2;

@@ -18,6 +18,13 @@
 // texel so that float texture coordinates rounded across the square's edge still read owned
 // texels; it samples the chart's point nearest its centre (the point mapped to the centre,
 // inside the chart).
+//
+// A chart can still be an embedded disk whose boundary runs back alongside itself (around a
+// notch, or where it curls round an ear): texels between the two sides are read from both,
+// yet the sides are far apart on the surface. After filling, every chart whose lookups read
+// a texel sampling a point more than kNearTexels texel widths (in 3D) from the lookup is
+// cut in two and everything packed again, for up to kMaxRounds rounds; then whatever is
+// still cut goes flat triangle by triangle.
 #include "atlas_detail.h"
 
 #include "meshes/charts.h"
