@@ -323,6 +323,7 @@ Eigen::Vector3d surface_point(const Mesh& mesh, int t, const Eigen::Vector3d& w)
 
 struct AtlasFigures {
   double used = 0;         // fraction of the texels owned
+  double interior = 0;     // fraction of the texels whose centres lie inside a chart
   double stretch_max = 0;  // sqrt(texture area / surface area) per triangle, over its mean
   double stretch_min = 0;
   double stretch_rms = 0;  // RMS of (stretch - 1), area-weighted
@@ -382,6 +383,19 @@ AtlasFigures check_conformal_atlas(const Mesh& mesh, const Atlas& atlas, double 
 
   AtlasFigures figures;
   figures.used = double(atlas.used_texels()) / (double(atlas.width) * atlas.height);
+  for (int y = 0; y < atlas.height; ++y) {
+    for (int x = 0; x < atlas.width; ++x) {
+      const std::size_t at = std::size_t(y) * atlas.width + x;
+      const int t = atlas.texel_triangle[at];
+      if (t < 0) continue;
+      const Eigen::Vector2f w = atlas.texel_barycentric[at];
+      const Eigen::Vector2f p = (1 - w.x() - w.y()) * atlas.uv[3 * t] +
+                                w.x() * atlas.uv[3 * t + 1] + w.y() * atlas.uv[3 * t + 2];
+      const Eigen::Vector2f centre((x + 0.5f) / atlas.width, (y + 0.5f) / atlas.height);
+      if ((p - centre).norm() < 1e-5f) figures.interior += 1;
+    }
+  }
+  figures.interior /= double(atlas.width) * atlas.height;
   figures.stretch_min = INFINITY;
   double weighted = 0;
   for (std::size_t t = 0; t < count; ++t) {
@@ -445,11 +459,11 @@ AtlasFigures check_conformal_atlas(const Mesh& mesh, const Atlas& atlas, double 
 void print(const char* name, const Mesh& mesh, const Atlas& atlas, const AtlasFigures& f,
            double seconds) {
   std::printf(
-      "%s: %zu triangles, %d charts, %dx%d, %.1f %% of texels used, built in %.3f s; "
-      "area stretch sqrt(uv/3D) per triangle over its mean: min %.3f max %.3f RMS "
-      "deviation %.3f\n",
+      "%s: %zu triangles, %d charts, %dx%d, %.1f %% of texels used (%.1f %% inside charts), "
+      "built in %.3f s; area stretch sqrt(uv/3D) per triangle over its mean: min %.3f max %.3f "
+      "RMS deviation %.3f\n",
       name, mesh.triangles.size(), atlas.chart_count, atlas.width, atlas.height, 100 * f.used,
-      seconds, f.stretch_min, f.stretch_max, f.stretch_rms);
+      100 * f.interior, seconds, f.stretch_min, f.stretch_max, f.stretch_rms);
 }
 
 // Interior lookups read texels whose centres are within sqrt(2) texels of the point, and a
@@ -468,6 +482,25 @@ TEST(ConformalAtlas, UvSphere) {
   EXPECT_LT(atlas.chart_count, int(mesh.triangles.size()) / 8);  // charts of many triangles
   EXPECT_LE(f.stretch_max, 2.0 + 1e-3);
   EXPECT_GE(f.stretch_min, 0.5 - 1e-3);
+}
+
+TEST(ConformalAtlas, SliversDegenerateTrianglesOpenBoxesAndTori) {
+  // Degenerate and tiny triangles become charts of their own; an open box's faces meet at
+  // right angles (beyond the normal cone) and have a border; a torus is not a disk anywhere.
+  for (const auto& [name, mesh] :
+       {std::pair{"slivers", test_mesh()}, std::pair{"open box", meshes::make_open_box(2.f, 8)},
+        std::pair{"torus", meshes::make_torus(1.f, 0.35f, 48, 24)},
+        std::pair{"plane and sphere", meshes::make_plane_and_sphere()}}) {
+    SCOPED_TRACE(name);
+    const auto start = std::chrono::steady_clock::now();
+    const Atlas atlas = meshes::make_atlas(mesh, 128, 128);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(atlas.charts, meshes::AtlasCharts::kConformal);
+    const AtlasFigures f = check_conformal_atlas(mesh, atlas, kNear);
+    print(name, mesh, atlas, f, seconds);
+    EXPECT_LT(atlas.chart_count, int(mesh.triangles.size()) / 4 + 8);
+  }
 }
 
 TEST(ConformalAtlas, Icosphere) {

@@ -134,6 +134,28 @@ Atlas make_per_triangle_atlas(const Mesh& mesh, int width, int height);
 Eigen::Vector3d atlas_detail::nearest_weights(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
                                               const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
   const Eigen::Vector2d ab = b - a, ac = c - a, ap = p - a;
+  // A triangle flattened to a segment (or a point) has no inside: its nearest point is on
+  // one of its edges (the Voronoi regions below assume a proper triangle).
+  const double longest = std::max({ab.squaredNorm(), ac.squaredNorm(), (c - b).squaredNorm()});
+  if (!(std::abs(ab.x() * ac.y() - ab.y() * ac.x()) > 1e-12 * longest)) {
+    const Eigen::Vector2d* q[3] = {&a, &b, &c};
+    Eigen::Vector3d best(1, 0, 0);
+    double best_distance = INFINITY;
+    for (int e = 0; e < 3; ++e) {
+      const int i = e, j = (e + 1) % 3;
+      const Eigen::Vector2d d = *q[j] - *q[i];
+      const double length = d.squaredNorm();
+      const double t = length > 0 ? std::clamp((p - *q[i]).dot(d) / length, 0.0, 1.0) : 0.0;
+      const double distance = (*q[i] + t * d - p).squaredNorm();
+      if (distance < best_distance) {
+        best_distance = distance;
+        best.setZero();
+        best[i] = 1 - t;
+        best[j] = t;
+      }
+    }
+    return best;
+  }
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
   if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
   const Eigen::Vector2d bp = p - b;
