@@ -1,9 +1,8 @@
 // The conformal atlas (meshes/atlas.h): charts grown over the surface (meshes/charts.h),
 // flattened by least-squares conformal maps (meshes/conformal_map.h), checked, each scaled so
-// its texture area equals its surface area, turned to its smallest bounding box, and
-// shelf-packed at the largest common scale that fits (Lévy et al., "Least Squares Conformal
-// Maps for Automatic Texture Atlas Generation", SIGGRAPH 2002, Secs. 3-5, with bounding boxes
-// on shelves instead of their Tetris packing).
+// its texture area equals its surface area, turned to its smallest bounding box, and packed
+// at the largest common scale that fits (Lévy et al., "Least Squares Conformal Maps for
+// Automatic Texture Atlas Generation", SIGGRAPH 2002, Secs. 3-5).
 //
 // A chart is accepted when its map is an embedded disk and its area stretch, sqrt(texture
 // area / surface area) per triangle at the chart's own scale, stays within [1/2, 2]: the
@@ -11,13 +10,13 @@
 // is cut in two (meshes::split_chart) and each part tried again; a single triangle is laid
 // flat by its own edge lengths (isometric, also for degenerate triangles).
 //
-// Each chart sits in its own cell of S_x x S_y texels (the rule of meshes/src/atlas_detail.h:
-// lookups from inside it read only the cell's texels, so no two charts share a texel and the
-// cells form the gutters). A texel is the chart's when the chart meets the square its
-// lookups come from, [i - 0.5, i + 1.5] x [j - 0.5, j + 1.5], widened by a thousandth of a
-// texel so that float texture coordinates rounded across the square's edge still read owned
-// texels; it samples the chart's point nearest its centre (the point mapped to the centre,
-// inside the chart).
+// Each chart has a cell of S_x x S_y texels (the rule of meshes/src/atlas_detail.h: lookups
+// from inside it read only the cell's texels). A texel is read by the chart when the chart
+// meets the square its lookups come from, [i - 0.5, i + 1.5] x [j - 0.5, j + 1.5], widened
+// by a thousandth of a texel so that float texture coordinates rounded across the square's
+// edge still read owned texels. Packing keeps the read texels of different charts apart
+// (cells may overlap where the charts do not read), so a texel belongs to one chart and
+// samples that chart's point nearest its centre (the point mapped to the centre, inside it).
 //
 // A chart can still be an embedded disk whose boundary runs back alongside itself (around a
 // notch, or where it curls round an ear): texels between the two sides are read from both,
@@ -31,6 +30,7 @@
 #include "meshes/conformal_map.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <numeric>
 #include <stdexcept>
@@ -58,7 +58,9 @@ struct Layout {
 };
 
 struct Placed {
-  int x = 0, y = 0, side_x = 0, side_y = 0;  // the cell
+  int x = 0, y = 0;            // where the turned cell's texel (0, 0) goes
+  int side_x = 0, side_y = 0;  // the cell before it is turned
+  int turns = 0;               // quarter turns (turn())
 };
 
 double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -189,34 +191,6 @@ void fit_box(Layout* layout) {
   layout->height = quarter ? hi.x() - lo.x() : hi.y() - lo.y();
 }
 
-// Cells at scale k (texels per unit length) for the layouts in `order` (tallest first),
-// shelf-packed; false when they do not fit width x height.
-bool pack_cells(const std::vector<Layout>& layouts, const std::vector<int>& order, double k,
-                int width, int height, std::vector<Placed>* placed) {
-  if (placed) placed->assign(layouts.size(), Placed{});
-  int x = 0, y = 0, shelf = 0;
-  for (int c : order) {
-    const double sx = k * layouts[c].width + 1 + 2 * atlas_detail::kInset;
-    const double sy = k * layouts[c].height + 1 + 2 * atlas_detail::kInset;
-    if (!(sx < width + 1) || !(sy < height + 1)) return false;
-    Placed cell;
-    cell.side_x = int(std::ceil(sx));
-    cell.side_y = int(std::ceil(sy));
-    if (x + cell.side_x > width) {
-      x = 0;
-      y += shelf;
-      shelf = 0;
-    }
-    if (x + cell.side_x > width || y + cell.side_y > height) return false;
-    cell.x = x;
-    cell.y = y;
-    x += cell.side_x;
-    shelf = std::max(shelf, cell.side_y);
-    if (placed) (*placed)[c] = cell;
-  }
-  return true;
-}
-
 // Whether the triangle meets the axis-aligned box [lo, hi] (separating axes: the box's two
 // and the triangle's edge normals; a degenerate triangle's zero normals separate nothing).
 bool triangle_meets_box(const Eigen::Vector2d q[3], const Eigen::Vector2d& lo,
@@ -269,6 +243,154 @@ std::vector<Eigen::Vector2d> clip_to_box(const Eigen::Vector2d q[3], const Eigen
   return poly;
 }
 
+// A chart in its cell at scale k: local cell coordinates c = (0.5 + d) + k corner, cell
+// S_x x S_y. Turned by quarter turns about the cell (rotations, so triangles keep their
+// orientation): 1: (S_y - c_y, c_x), 2: (S_x - c_x, S_y - c_y), 3: (c_y, S_x - c_x). A turned
+// cell reads texel (i', j') exactly where the unturned one reads the texel it maps back to,
+// since the read squares [i - 0.5, i + 1.5] map onto each other.
+Eigen::Vector2d turn(const Eigen::Vector2d& c, int turns, int side_x, int side_y) {
+  switch (turns) {
+    case 1:
+      return {side_y - c.y(), c.x()};
+    case 2:
+      return {side_x - c.x(), side_y - c.y()};
+    case 3:
+      return {c.y(), side_x - c.x()};
+    default:
+      return c;
+  }
+}
+
+// The texels a chart's lookups read in its cell at scale k, as spans: per column the lowest
+// and highest row, per row the leftmost and rightmost column. Texel (i, j) is read when a
+// triangle meets [i - 0.5, i + 1.5] x [j - 0.5, j + 1.5] (widened by the slack), so a column's
+// rows follow from the y-range of each triangle clipped to the column's slab (its whole
+// y-range for a triangle within two columns, a little more than exact). Texels between two
+// read ones of a span count as read: a notch is not filled by another chart.
+struct Profile {
+  int side_x = 0, side_y = 0;
+  std::vector<int> column_lo, column_hi;  // per column; lo > hi when it is not read
+  std::vector<int> row_lo, row_hi;        // per row
+};
+
+void add_spans(const Eigen::Vector2d q[3], int axis, int side_along, int side_across,
+               std::vector<int>& lo, std::vector<int>& hi) {
+  const int other = 1 - axis;
+  const double mn = std::min({q[0][axis], q[1][axis], q[2][axis]});
+  const double mx = std::max({q[0][axis], q[1][axis], q[2][axis]});
+  const int i0 = std::max(0, int(std::ceil(mn - 1.5 - kReadSlack)));
+  const int i1 = std::min(side_along - 1, int(std::floor(mx + 0.5 + kReadSlack)));
+  const double whole_lo = std::min({q[0][other], q[1][other], q[2][other]});
+  const double whole_hi = std::max({q[0][other], q[1][other], q[2][other]});
+  for (int i = i0; i <= i1; ++i) {
+    double y0 = whole_lo, y1 = whole_hi;
+    if (i1 - i0 > 2) {
+      Eigen::Vector2d box_lo = Eigen::Vector2d::Constant(-INFINITY), box_hi = -box_lo;
+      box_lo[axis] = i - 0.5 - kReadSlack;
+      box_hi[axis] = i + 1.5 + kReadSlack;
+      const std::vector<Eigen::Vector2d> part = clip_to_box(q, box_lo, box_hi);
+      if (part.empty()) continue;
+      y0 = INFINITY, y1 = -INFINITY;
+      for (const Eigen::Vector2d& v : part)
+        y0 = std::min(y0, v[other]), y1 = std::max(y1, v[other]);
+    }
+    lo[i] = std::min(lo[i], std::max(0, int(std::ceil(y0 - 1.5 - kReadSlack))));
+    hi[i] = std::max(hi[i], std::min(side_across - 1, int(std::floor(y1 + 0.5 + kReadSlack))));
+  }
+}
+
+Profile profile_of(const Layout& layout, double k) {
+  Profile p;
+  p.side_x = int(std::ceil(k * layout.width + 1 + 2 * atlas_detail::kInset));
+  p.side_y = int(std::ceil(k * layout.height + 1 + 2 * atlas_detail::kInset));
+  p.column_lo.assign(p.side_x, p.side_y);
+  p.column_hi.assign(p.side_x, -1);
+  p.row_lo.assign(p.side_y, p.side_x);
+  p.row_hi.assign(p.side_y, -1);
+  const Eigen::Vector2d origin = Eigen::Vector2d::Constant(0.5 + atlas_detail::kInset);
+  for (std::size_t t = 0; t < layout.triangles.size(); ++t) {
+    Eigen::Vector2d q[3];
+    for (int m = 0; m < 3; ++m) q[m] = origin + k * layout.corners[3 * t + m];
+    add_spans(q, 0, p.side_x, p.side_y, p.column_lo, p.column_hi);
+    add_spans(q, 1, p.side_y, p.side_x, p.row_lo, p.row_hi);
+  }
+  return p;
+}
+
+// The column spans of the chart turned `turns` quarter turns (turn() above): column i of
+// the turned cell is a row or column of the unturned one, its span mirrored as the turn says.
+void turned_columns(const Profile& p, int turns, std::vector<int>& lo, std::vector<int>& hi) {
+  const int width = turns % 2 ? p.side_y : p.side_x;
+  lo.resize(width);
+  hi.resize(width);
+  for (int i = 0; i < width; ++i) {
+    int a = 0, b = 0;
+    switch (turns) {
+      case 1:  // column i is row S_y - 1 - i; rows are columns
+        a = p.row_lo[p.side_y - 1 - i], b = p.row_hi[p.side_y - 1 - i];
+        break;
+      case 2:  // column i is column S_x - 1 - i, rows mirrored
+        a = p.side_y - 1 - p.column_hi[p.side_x - 1 - i];
+        b = p.side_y - 1 - p.column_lo[p.side_x - 1 - i];
+        break;
+      case 3:  // column i is row i; rows are mirrored columns
+        a = p.side_x - 1 - p.row_hi[i], b = p.side_x - 1 - p.row_lo[i];
+        break;
+      default:
+        a = p.column_lo[i], b = p.column_hi[i];
+    }
+    lo[i] = a, hi[i] = b;
+  }
+}
+
+// Skyline packing of the charts' spans (after the Tetris packing of Lévy et al. 2002,
+// Sec. 5): each chart, in order, in each of its four quarter turns, goes where its top ends
+// lowest above the atlas's current horizon (then where it wastes the fewest texels between
+// the horizon and its lower edge), and raises the horizon to its upper edge. Charts' read
+// texels never meet, so their cells may overlap.
+bool pack_skyline(const std::vector<Layout>& layouts, const std::vector<int>& order, double k,
+                  int width, int height, std::vector<Placed>* placed) {
+  if (placed) placed->assign(layouts.size(), Placed{});
+  std::vector<int> horizon(width, 0), lo, hi;
+  for (int c : order) {
+    const double sx = k * layouts[c].width + 1 + 2 * atlas_detail::kInset;
+    const double sy = k * layouts[c].height + 1 + 2 * atlas_detail::kInset;
+    if (!(sx < std::max(width, height) + 1) || !(sy < std::max(width, height) + 1)) return false;
+    const Profile p = profile_of(layouts[c], k);
+    Placed best;
+    long long best_waste = 0, best_top = 0;
+    bool found = false;
+    for (int turns = 0; turns < 4; ++turns) {
+      turned_columns(p, turns, lo, hi);
+      const int side = int(lo.size());
+      for (int x = 0; x + side <= width; ++x) {
+        int y = INT_MIN;
+        for (int i = 0; i < side; ++i)
+          if (lo[i] <= hi[i]) y = std::max(y, horizon[x + i] - lo[i]);
+        if (y == INT_MIN) y = 0;
+        long long waste = 0, top = 0;
+        for (int i = 0; i < side; ++i) {
+          if (lo[i] > hi[i]) continue;
+          waste += y + lo[i] - horizon[x + i];
+          top = std::max<long long>(top, y + hi[i]);
+        }
+        if (top >= height) continue;
+        if (!found || top < best_top || (top == best_top && waste < best_waste)) {
+          found = true;
+          best = Placed{x, y, p.side_x, p.side_y, turns};
+          best_waste = waste, best_top = top;
+        }
+      }
+    }
+    if (!found) return false;
+    turned_columns(p, best.turns, lo, hi);
+    for (int i = 0; i < int(lo.size()); ++i)
+      if (lo[i] <= hi[i]) horizon[best.x + i] = best.y + hi[i] + 1;
+    if (placed) (*placed)[c] = best;
+  }
+  return true;
+}
+
 // Weights of a, b and c giving p (the triangle is not degenerate).
 Eigen::Vector3d barycentric(const Eigen::Vector2d& p, const Eigen::Vector2d q[3]) {
   const Eigen::Vector2d e1 = q[1] - q[0], e2 = q[2] - q[0], d = p - q[0];
@@ -318,12 +440,18 @@ Filled fill_texels(const Mesh& mesh, const std::vector<Layout>& layouts,
   const double far = kNearTexels / k;
   for (int c = 0; c < charts; ++c) {
     const Layout& layout = layouts[c];
-    const Placed& cell = cells[c];
-    const Eigen::Vector2d origin(cell.x + 0.5 + atlas_detail::kInset,
-                                 cell.y + 0.5 + atlas_detail::kInset);
+    const Placed& placed = cells[c];
+    // The turned cell: its texels x .. x + side_x - 1, y .. y + side_y - 1.
+    const bool quarter = placed.turns % 2 == 1;
+    const Placed cell{placed.x, placed.y, quarter ? placed.side_y : placed.side_x,
+                      quarter ? placed.side_x : placed.side_y, 0};
+    const Eigen::Vector2d origin = Eigen::Vector2d::Constant(0.5 + atlas_detail::kInset);
     best.assign(std::size_t(cell.side_x) * cell.side_y, Best{});
     const auto corners = [&](std::size_t i, Eigen::Vector2d q[3]) {
-      for (int m = 0; m < 3; ++m) q[m] = origin + k * layout.corners[3 * i + m];
+      for (int m = 0; m < 3; ++m) {
+        q[m] = Eigen::Vector2d(cell.x, cell.y) + turn(origin + k * layout.corners[3 * i + m],
+                                                      placed.turns, placed.side_x, placed.side_y);
+      }
     };
     // Texels whose centres lie within 2 texels of the triangle's box: any nearer point of
     // the chart to a texel the chart reads lies within sqrt(2) of its centre.
@@ -362,6 +490,10 @@ Filled fill_texels(const Mesh& mesh, const std::vector<Layout>& layouts,
       for (int x = 0; x < cell.side_x; ++x) {
         Best& b = best[std::size_t(j) * cell.side_x + x];
         if (!b.read) continue;
+        if (cell.x + x < 0 || cell.x + x >= width || cell.y + j < 0 || cell.y + j >= height) {
+          throw std::logic_error("make_atlas: a chart reads texel (" + std::to_string(cell.x + x) +
+                                 ", " + std::to_string(cell.y + j) + ") outside the atlas");
+        }
         const std::size_t at = std::size_t(cell.y + j) * width + (cell.x + x);
         if (atlas.texel_triangle[at] >= 0) {
           throw std::logic_error("make_atlas: texel (" + std::to_string(cell.x + x) + ", " +
@@ -442,11 +574,11 @@ Atlas atlas_detail::make_conformal_atlas(const Mesh& mesh, int width, int height
     const int charts = int(layouts.size());
     std::vector<int> order(charts);
     std::iota(order.begin(), order.end(), 0);
+    // Largest bounding box first, the small ones fill the gaps the large ones leave.
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
-      if (layouts[a].height != layouts[b].height) return layouts[a].height > layouts[b].height;
-      return layouts[a].width > layouts[b].width;
+      return layouts[a].width * layouts[a].height > layouts[b].width * layouts[b].height;
     });
-    if (!impl::pack_cells(layouts, order, 0.0, width, height, nullptr)) {
+    if (!impl::pack_skyline(layouts, order, 0.0, width, height, nullptr)) {
       throw std::invalid_argument(
           "a " + std::to_string(width) + " x " + std::to_string(height) +
           " atlas is too small to hold the mesh's " + std::to_string(charts) +
@@ -459,13 +591,13 @@ Atlas atlas_detail::make_conformal_atlas(const Mesh& mesh, int width, int height
                                                layout.corners[3 * i + 2] - layout.corners[3 * i]));
     // The charts' area alone bounds the scale: k^2 surface <= width height.
     double lo = 0, hi = surface > 0 ? std::sqrt(double(width) * height / surface) : 0.0;
-    if (hi > 0 && impl::pack_cells(layouts, order, hi, width, height, nullptr)) lo = hi;
-    for (int it = 0; it < 50 && hi - lo > 1e-9 * hi; ++it) {
+    if (hi > 0 && impl::pack_skyline(layouts, order, hi, width, height, nullptr)) lo = hi;
+    for (int it = 0; it < 40 && hi - lo > 1e-4 * hi; ++it) {
       const double mid = 0.5 * (lo + hi);
-      (impl::pack_cells(layouts, order, mid, width, height, nullptr) ? lo : hi) = mid;
+      (impl::pack_skyline(layouts, order, mid, width, height, nullptr) ? lo : hi) = mid;
     }
     std::vector<impl::Placed> cells;
-    impl::pack_cells(layouts, order, lo, width, height, &cells);
+    impl::pack_skyline(layouts, order, lo, width, height, &cells);
     impl::Filled filled = impl::fill_texels(mesh, layouts, cells, lo, width, height);
     if (filled.far.empty()) return std::move(filled.atlas);
     // Cut the charts that mix far points and pack again (their cells change the scale).
