@@ -146,6 +146,7 @@ void run(const Options& o, CLI::App*) {
     Json j;
     j["rows"] = r.slf.bake.row_count;
     j["atlas_rows"] = r.slf.bake.rows;
+    j["atlas_charts"] = meshes::kAtlasChartsNames.name(r.slf.bake.charts);
     j["directions"] = r.slf.bake.grid.directions();
     j["data_generation_seconds"] = r.bake_seconds;
     j["bake_cached"] = r.bake_cached;

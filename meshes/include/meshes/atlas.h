@@ -8,8 +8,10 @@
 //    texel count grows with the triangle count);
 //  - conformal (the default): charts of many triangles (meshes/charts.h), each flattened by a
 //    least-squares conformal map (meshes/conformal_map.h) and scaled so its texture area
-//    follows its surface area; a chart that does not flatten one-to-one, or whose area
-//    stretch is too uneven, is cut again, down to single triangles.
+//    follows its surface area; a chart that does not flatten one-to-one, whose area stretch
+//    is too uneven, or whose lookups read texels sampling far-away points of itself (two
+//    stretches of its boundary side by side in the texture) is cut again, down to single
+//    triangles if need be.
 // A texel belongs to at most one chart: the one whose bilinear lookups read it. It samples
 // the point of that chart that maps to its centre, and a texel around a chart (its gutter)
 // the chart's nearest point, so a bilinear lookup anywhere inside a chart reads only texels
