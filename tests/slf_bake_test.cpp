@@ -1,8 +1,10 @@
 // Tests for prt/slf_bake.h: a Lambert sphere under a white sky gives a constant matrix (the
 // albedo, every texel and direction, silhouette views included), the streamed file holds the
-// in-memory bake, row ranges baked apart join to the whole bake's bytes, and damaged files
-// are refused with messages naming the file.
+// in-memory bake, row ranges baked apart join to the whole bake's bytes, the file records how
+// the atlas was cut (a version 1 file, from before conformal charts, reads as per-triangle),
+// and damaged files are refused with messages naming the file.
 #include "prt/slf_bake.h"
+#include "common/hash.h"
 #include "meshes/atlas.h"
 #include "meshes/frames.h"
 #include "meshes/procedural.h"
@@ -11,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -121,6 +124,52 @@ TEST(SlfBake, FileHoldsTheBakeAndPartsJoinToIt) {
 
   o.end_row = whole.shape.rows + 1;
   EXPECT_THROW(prt::bake_slf(s.mesh, s.atlas, s.sky, o), std::invalid_argument);
+}
+
+// The header as version 1 wrote it: version 1 and a u32 width at 16 (its high half, where
+// version 2 keeps the charts, zero), the header checksum at 120 recomputed.
+std::string as_version(std::string bytes, std::uint32_t version, std::uint16_t charts) {
+  std::memcpy(bytes.data() + 8, &version, 4);
+  std::memcpy(bytes.data() + 18, &charts, 2);
+  const std::uint64_t sum = common::fnv1a(bytes.data(), 120);
+  std::memcpy(bytes.data() + 120, &sum, 8);
+  return bytes;
+}
+
+TEST(SlfBake, TheFileRecordsTheChartsAndVersion1ReadsAsPerTriangle) {
+  const Scene s;
+  const meshes::Atlas per_triangle =
+      meshes::make_atlas(s.mesh, 24, 24, {meshes::AtlasCharts::kPerTriangle});
+  ASSERT_EQ(s.atlas.charts, meshes::AtlasCharts::kConformal);
+  const fs::path conformal_path = scratch("slf_bake", "conformal.slf");
+  prt::bake_slf_to_file(s.mesh, s.atlas, s.sky, lambert_options(1), conformal_path);
+  EXPECT_EQ(prt::read_slf(conformal_path).shape.charts, meshes::AtlasCharts::kConformal);
+  const fs::path path = scratch("slf_bake", "per_triangle.slf");
+  prt::bake_slf_to_file(s.mesh, per_triangle, s.sky, lambert_options(1), path);
+  const prt::SlfMatrix v2 = prt::read_slf(path);
+  EXPECT_EQ(v2.shape.charts, meshes::AtlasCharts::kPerTriangle);
+  EXPECT_EQ(v2.shape.rows, per_triangle.used_texels());
+
+  const std::string bytes = test_support::slurp(path);
+  const fs::path old = test_support::write_scratch("slf_bake", "v1.slf", as_version(bytes, 1, 0));
+  const prt::SlfMatrix v1 = prt::read_slf(old);
+  EXPECT_EQ(v1.shape.charts, meshes::AtlasCharts::kPerTriangle);
+  EXPECT_EQ(v1.shape.atlas_width, 24);
+  EXPECT_EQ(v1.data, v2.data);
+  const auto read = [](const fs::path& p) { prt::read_slf(p); };
+  // Version 1 had no charts field: bytes 18-19 belonged to its width.
+  test_support::error_of<prt::SlfFileError>(
+      test_support::write_scratch("slf_bake", "v1wide.slf", as_version(bytes, 1, 1)), read,
+      "atlas size");
+  test_support::error_of<prt::SlfFileError>(
+      test_support::write_scratch("slf_bake", "charts.slf", as_version(bytes, 2, 7)), read,
+      "atlas chart method 7 is unknown");
+  test_support::error_of<prt::SlfFileError>(
+      test_support::write_scratch("slf_bake", "v3.slf", as_version(bytes, 3, 0)), read,
+      "newer prtr version");
+  test_support::error_of<prt::SlfFileError>(
+      test_support::write_scratch("slf_bake", "v0.slf", as_version(bytes, 0, 0)), read,
+      "reads versions 1 to 2");
 }
 
 TEST(SlfBake, DamagedFilesAreRefusedNamingTheFile) {

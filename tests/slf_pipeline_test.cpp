@@ -1,6 +1,8 @@
 // Tests for pipeline/slf.h and pipeline/slf_file.h: the SLF pipeline's error figures agree
 // with cpca's own and with a reconstruction from the written file, the cache is used and
-// survives a damaged entry, and .slfc files round-trip and refuse damage naming the file.
+// survives a damaged entry, and .slfc files round-trip (recording the atlas's charts; a
+// version 1 file reads as per-triangle) and refuse damage naming the file.
+#include "common/hash.h"
 #include "meshes/frames.h"
 #include "meshes/procedural.h"
 #include "pipeline/slf.h"
@@ -11,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -63,6 +66,7 @@ TEST(SlfPipeline, ErrorFiguresMatchCpcaAndTheWrittenFile) {
   EXPECT_EQ(read.probe_name, "gradient");
   EXPECT_EQ(read.bake.rows, slf.bake.rows);
   EXPECT_EQ(read.bake.grid.azimuth, 6);
+  EXPECT_EQ(read.bake.charts, meshes::AtlasCharts::kConformal);
   EXPECT_EQ(read.bake.material.exponent, 8.f);
   EXPECT_EQ(read.bake.mesh_hash, meshes::content_hash(scene.mesh));
   EXPECT_EQ(read.bake.probe_hash, prt::probe_hash(scene.probe));
@@ -124,7 +128,12 @@ TEST(SlfPipeline, BadSettingsAndDamagedFilesAreRefused) {
   EXPECT_THROW(pipeline::make_slf(scene.mesh, "m", scene.probe, "p", s, {}, {}),
                std::invalid_argument);
   s = settings();
+  s.charts = meshes::AtlasCharts::kPerTriangle;
   s.atlas_width = s.atlas_height = 8;  // 56 triangles need 28 cells of 4 x 4
+  EXPECT_THROW(pipeline::make_slf(scene.mesh, "m", scene.probe, "p", s, {}, {}),
+               std::invalid_argument);
+  s.charts = meshes::AtlasCharts::kConformal;
+  s.atlas_width = s.atlas_height = 4;  // more charts than 2 x 2 cells
   EXPECT_THROW(pipeline::make_slf(scene.mesh, "m", scene.probe, "p", s, {}, {}),
                std::invalid_argument);
 
@@ -155,6 +164,26 @@ TEST(SlfPipeline, BadSettingsAndDamagedFilesAreRefused) {
                                                   read, "truncated header");
   test_support::error_of<pipeline::SlfcFileError>(scratch("slf_pipeline", "none.slfc"), read,
                                                   "create it with prtr slf");
+  // A version 1 file (u32 width at 16, so no charts field; the checksum recomputed) reads
+  // as per-triangle charts, which were all version 1 had.
+  ASSERT_EQ(run.slf.bake.charts, meshes::AtlasCharts::kConformal);
+  std::string old = bytes;
+  const std::uint32_t version = 1;
+  std::memcpy(old.data() + 8, &version, 4);
+  old[18] = old[19] = 0;
+  const std::uint64_t sum = common::fnv1a(old.data(), 120);
+  std::memcpy(old.data() + 120, &sum, 8);
+  const pipeline::CompressedSlf v1 = pipeline::read_slfc(damaged("v1.slfc", old));
+  EXPECT_EQ(v1.bake.charts, meshes::AtlasCharts::kPerTriangle);
+  EXPECT_EQ(v1.bake.atlas_width, 24);
+  EXPECT_EQ(v1.set.weights, run.slf.set.weights);
+  std::string unknown = bytes;
+  unknown[18] = 9;
+  const std::uint64_t resealed = common::fnv1a(unknown.data(), 120);
+  std::memcpy(unknown.data() + 120, &resealed, 8);
+  test_support::error_of<pipeline::SlfcFileError>(damaged("charts.slfc", unknown), read,
+                                                  "atlas chart method 9 is unknown");
+
   pipeline::CompressedSlf bad = run.slf;
   bad.set.cluster_of[0] = 99;
   EXPECT_THROW(pipeline::write_slfc(scratch("slf_pipeline", "bad.slfc"), bad),

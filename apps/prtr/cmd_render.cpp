@@ -259,7 +259,8 @@ void run_slf(const Options& o, CLI::App* cmd) {
                      o.probe +
                      "; a surface light field's lighting is fixed, so "
                      "pass the probe it was made with");
-  const meshes::Atlas atlas = meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height);
+  const meshes::Atlas atlas =
+      meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height, {slf.bake.charts});
   const render::SlfModel model =
       render::slf_model_from_compressed(mesh, atlas, slf.bake.grid, slf.set);
   const render::Background background = resolve_background(o.view);

@@ -1,5 +1,6 @@
-// prtr slf MESH --probe P -o OUT.slfc: a surface light field (SLF paper, Secs. 3.1-3.2): a
-// per-triangle atlas of --samples texels, the exit radiance of every texel toward --directions
+// prtr slf MESH --probe P -o OUT.slfc: a surface light field (SLF paper, Secs. 3.1-3.2): an
+// atlas of --samples texels (--charts: conformal charts of many triangles, or one per
+// triangle as files of version 1 had), the exit radiance of every texel toward --directions
 // cells path traced under the probe (cached), CPCA of that matrix, and the figures the
 // paper's Table 1 reports: data generation time, compression time, compression ratio, and
 // the RMS error of the compressed matrix against the baked one.
@@ -11,6 +12,7 @@
 #include "mesh_flags.h"
 #include "progress_bar.h"
 
+#include "meshes/atlas.h"
 #include "meshes/load.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/slf.h"
@@ -29,7 +31,9 @@ namespace cmd_slf {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string mesh, probe, output, cache, samples = "256x256", directions = "32x16", rows;
+  std::string mesh, probe, output, cache,
+      samples = "256x256", directions = "32x16", rows,
+      charts = meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal);
   MaterialFlags material;
   MeshFlags mesh_flags;
   CompressFlags compress;
@@ -68,8 +72,12 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("-o,--output", o.output, "Compressed surface light field to write (.slfc)")
       ->required();
-  cmd->add_option("--samples", o.samples,
-                  "Atlas size WxH in texels: the surface samples (one chart per triangle)")
+  cmd->add_option("--samples", o.samples, "Atlas size WxH in texels: the surface samples")
+      ->capture_default_str();
+  cmd->add_option("--charts", o.charts,
+                  "How the atlas cuts the surface: conformal (charts of many triangles, LSCM) "
+                  "or per-triangle (at least 8 texels a triangle)")
+      ->check(CLI::IsMember(meshes::kAtlasChartsNames.names()))
       ->capture_default_str();
   cmd->add_option("--directions", o.directions,
                   "Direction grid ZxW: azimuth x polar cells over the sphere")
@@ -100,6 +108,7 @@ void run(const Options& o, CLI::App*) {
   pipeline::SlfSettings settings;
   std::tie(settings.atlas_width, settings.atlas_height) =
       parse_size(o.samples, "--samples", 4, 8192);
+  settings.charts = meshes::kAtlasChartsNames.parse(o.charts);
   std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
       parse_size(o.directions, "--directions", 1, 4096);
   std::tie(settings.bake.first_row, settings.bake.end_row) = parse_rows(o.rows);
@@ -137,6 +146,7 @@ void run(const Options& o, CLI::App*) {
     Json j;
     j["rows"] = r.slf.bake.row_count;
     j["atlas_rows"] = r.slf.bake.rows;
+    j["atlas_charts"] = meshes::kAtlasChartsNames.name(r.slf.bake.charts);
     j["directions"] = r.slf.bake.grid.directions();
     j["data_generation_seconds"] = r.bake_seconds;
     j["bake_cached"] = r.bake_cached;

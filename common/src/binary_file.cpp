@@ -69,12 +69,15 @@ std::string identity_problem(const VersionedHeader& h, const VersionedFormat& fo
            std::string(format.magic.data(), format.magic.size()) + "\"); name a " + format.file;
   }
   const auto version = get_field<std::uint32_t>(h, kOffVersion);
-  if (version != format.version) {
+  const std::uint32_t oldest = format.oldest_version ? format.oldest_version : format.version;
+  if (version < oldest || version > format.version) {
     const bool newer = version > format.version;
     return std::string("written by ") + (newer ? "a newer" : "an older") +
            " prtr version (file format version " + std::to_string(version) +
-           "; this prtr reads version " + std::to_string(format.version) + "); " +
-           (newer ? "use that prtr, or " : "") + remedy + " from this version";
+           "; this prtr reads version" +
+           (oldest == format.version ? " " : "s " + std::to_string(oldest) + " to ") +
+           std::to_string(format.version) + "); " + (newer ? "use that prtr, or " : "") + remedy +
+           " from this version";
   }
   const auto header_bytes = get_field<std::uint32_t>(h, kOffHeaderBytes);
   if (header_bytes != kVersionedHeaderBytes) {
@@ -85,6 +88,10 @@ std::string identity_problem(const VersionedHeader& h, const VersionedFormat& fo
   return {};
 }
 }  // namespace
+
+std::uint32_t header_version(const VersionedHeader& header) {
+  return get_field<std::uint32_t>(header, kOffVersion);
+}
 
 VersionedHeader begin_header(const VersionedFormat& format) {
   VersionedHeader h{};

@@ -6,16 +6,14 @@
 // legs follow the triangle's area (legs k sqrt(2 area), so a chart covers k^2 area texels),
 // with the scale k found by bisection as the largest that still packs.
 //
-// Coordinates below are in texels: texel x covers [x, x + 1), its centre is x + 0.5. A
-// bilinear lookup at p reads texels floor(p - 0.5) and floor(p - 0.5) + 1 on each axis, so
-// texel i is read by the points of [i - 0.5, i + 1.5). A cell of S x S texels at X holds its
-// charts between X + 0.5 + d and X + S - 0.5 - d (an inset d of a hundredth of a texel, so
-// that float texture coordinates, rounded, still read only the cell's texels): lookups there
-// read texels X .. X + S - 1, and cells can touch. Along the diagonal, lookups of the lower
+// Coordinates below are in texels, and a cell of S x S texels holds its charts as
+// meshes/src/atlas_detail.h says, so cells can touch. Along the diagonal, lookups of the lower
 // chart (x + y <= c) read texels with i + j <= floor(c) + 1, those of the upper one
 // (x + y >= c') texels with i + j > c' - 3; c' - c >= 4 keeps them apart, i.e.
 // a + b <= 2 S - 6 - 4 d for legs a and b.
 #include "meshes/atlas.h"
+
+#include "atlas_detail.h"
 
 #include <algorithm>
 #include <cmath>
@@ -26,8 +24,9 @@
 namespace meshes {
 namespace {
 
-constexpr int kMinSize = 4, kMaxSize = 8192;
-constexpr double kInset = 0.01;  // d above, in texels
+using atlas_detail::kInset;
+using atlas_detail::kMaxSize;
+using atlas_detail::nearest_weights;
 
 // One chart: a right isosceles triangle with its right angle at `corner`, legs `leg` long
 // along +-x and +-y (sign: +1 for a lower-left chart, -1 for an upper-right one).
@@ -69,39 +68,6 @@ bool chart_reads(const Chart& chart, int i, int j) {
   const bool open = r <= x0 || t <= y0;
   const double c = x0 + y0 - chart.leg;
   return open ? x + y > c : x + y >= c;
-}
-
-// The point of triangle (a, b, c) nearest to p, as weights of a, b and c (Ericson,
-// "Real-Time Collision Detection", 5.1.5, by Voronoi regions).
-Eigen::Vector3d nearest_weights(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                                const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-  const Eigen::Vector2d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
-  const Eigen::Vector2d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const double v = d1 / (d1 - d3);
-    return {1 - v, v, 0};
-  }
-  const Eigen::Vector2d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const double w = d2 / (d2 - d6);
-    return {1 - w, 0, w};
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return {0, 1 - w, w};
-  }
-  const double denom = 1 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  return {1 - v - w, v, w};
 }
 
 // The mesh corner with the largest angle goes to the right angle (least distortion).
@@ -158,14 +124,68 @@ bool pack(const std::vector<int>& order, const std::vector<double>& legs_unit, d
   return true;
 }
 
+// Per-triangle charts.
+Atlas make_per_triangle_atlas(const Mesh& mesh, int width, int height);
+
 }  // namespace
 
-std::size_t Atlas::used_texels() const {
-  return std::size_t(std::count_if(texel_triangle.begin(), texel_triangle.end(),
-                                   [](std::int32_t t) { return t >= 0; }));
+// The point of triangle (a, b, c) nearest to p, as weights of a, b and c (Ericson,
+// "Real-Time Collision Detection", 5.1.5, by Voronoi regions).
+Eigen::Vector3d atlas_detail::nearest_weights(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                              const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d ab = b - a, ac = c - a, ap = p - a;
+  // A triangle flattened to a segment (or a point) has no inside: its nearest point is on
+  // one of its edges (the Voronoi regions below assume a proper triangle).
+  const double longest = std::max({ab.squaredNorm(), ac.squaredNorm(), (c - b).squaredNorm()});
+  if (!(std::abs(ab.x() * ac.y() - ab.y() * ac.x()) > 1e-12 * longest)) {
+    const Eigen::Vector2d* q[3] = {&a, &b, &c};
+    Eigen::Vector3d best(1, 0, 0);
+    double best_distance = INFINITY;
+    for (int e = 0; e < 3; ++e) {
+      const int i = e, j = (e + 1) % 3;
+      const Eigen::Vector2d d = *q[j] - *q[i];
+      const double length = d.squaredNorm();
+      const double t = length > 0 ? std::clamp((p - *q[i]).dot(d) / length, 0.0, 1.0) : 0.0;
+      const double distance = (*q[i] + t * d - p).squaredNorm();
+      if (distance < best_distance) {
+        best_distance = distance;
+        best.setZero();
+        best[i] = 1 - t;
+        best[j] = t;
+      }
+    }
+    return best;
+  }
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return {1, 0, 0};
+  const Eigen::Vector2d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return {0, 1, 0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const double v = d1 / (d1 - d3);
+    return {1 - v, v, 0};
+  }
+  const Eigen::Vector2d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return {0, 0, 1};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const double w = d2 / (d2 - d6);
+    return {1 - w, 0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0, 1 - w, w};
+  }
+  const double denom = 1 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return {1 - v - w, v, w};
 }
 
-Atlas make_atlas(const Mesh& mesh, int width, int height) {
+void atlas_detail::check_atlas_input(const Mesh& mesh, int width, int height) {
+  using atlas_detail::kMinSize;
   for (const auto& [name, value] : {std::pair{"width", width}, std::pair{"height", height}}) {
     if (value < kMinSize || value > kMaxSize) {
       throw std::invalid_argument(std::string("atlas ") + name + " must be in [" +
@@ -174,6 +194,28 @@ Atlas make_atlas(const Mesh& mesh, int width, int height) {
     }
   }
   if (mesh.triangles.empty()) throw std::invalid_argument("make_atlas: the mesh has no triangles");
+}
+
+std::size_t Atlas::used_texels() const {
+  return std::size_t(std::count_if(texel_triangle.begin(), texel_triangle.end(),
+                                   [](std::int32_t t) { return t >= 0; }));
+}
+
+Atlas make_atlas(const Mesh& mesh, int width, int height, const AtlasOptions& options) {
+  atlas_detail::check_atlas_input(mesh, width, height);
+  switch (options.charts) {
+    case AtlasCharts::kPerTriangle:
+      return make_per_triangle_atlas(mesh, width, height);
+    case AtlasCharts::kConformal:
+      return atlas_detail::make_conformal_atlas(mesh, width, height);
+  }
+  throw std::invalid_argument("make_atlas: unknown chart method " +
+                              std::to_string(std::uint32_t(options.charts)));
+}
+
+namespace {
+
+Atlas make_per_triangle_atlas(const Mesh& mesh, int width, int height) {
   const int count = int(mesh.triangles.size());
   std::vector<double> legs_unit(count);  // leg at k = 1: the chart's area equals the triangle's
   double total_area = 0;
@@ -205,11 +247,15 @@ Atlas make_atlas(const Mesh& mesh, int width, int height) {
   pack(order, legs_unit, lo, width, height, &cells);
 
   Atlas atlas;
+  atlas.charts = AtlasCharts::kPerTriangle;
   atlas.width = width;
   atlas.height = height;
   atlas.uv.assign(3 * std::size_t(count), Eigen::Vector2f::Zero());
   atlas.texel_triangle.assign(std::size_t(width) * height, -1);
   atlas.texel_barycentric.assign(std::size_t(width) * height, Eigen::Vector2f::Zero());
+  atlas.triangle_chart.resize(count);
+  std::iota(atlas.triangle_chart.begin(), atlas.triangle_chart.end(), 0);
+  atlas.chart_count = count;
 
   auto place = [&](int t, const Chart& chart) {
     Eigen::Vector2d q[3];  // chart points of mesh corners 0, 1, 2
@@ -264,4 +310,5 @@ Atlas make_atlas(const Mesh& mesh, int width, int height) {
   return atlas;
 }
 
+}  // namespace
 }  // namespace meshes

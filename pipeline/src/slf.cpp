@@ -30,7 +30,7 @@ void hash_value(std::uint64_t& h, const T& value) {
 
 std::uint64_t bake_key(const meshes::Mesh& mesh, const probes::Probe& probe, const SlfSettings& s) {
   std::uint64_t h = common::kFnvOffset;
-  hash_value(h, std::uint32_t(1));  // this key's layout
+  hash_value(h, std::uint32_t(2));  // this key's layout
   hash_value(h, meshes::content_hash(mesh));
   hash_value(h, prt::probe_hash(probe));
   const prt::SlfBakeOptions& o = s.bake;
@@ -38,7 +38,7 @@ std::uint64_t bake_key(const meshes::Mesh& mesh, const probes::Probe& probe, con
        {std::int64_t(s.atlas_width), std::int64_t(s.atlas_height), std::int64_t(o.grid.azimuth),
         std::int64_t(o.grid.elevation), std::int64_t(o.spp), std::int64_t(o.bounces),
         std::int64_t(o.seed), std::int64_t(o.first_row), std::int64_t(o.end_row),
-        std::int64_t(o.material.kind), std::int64_t(o.material.masking)})
+        std::int64_t(o.material.kind), std::int64_t(o.material.masking), std::int64_t(s.charts)})
     hash_value(h, v);
   for (float v : {o.material.albedo.x(), o.material.albedo.y(), o.material.albedo.z(),
                   o.material.specular, o.material.exponent, o.material.roughness, o.material.f0})
@@ -59,7 +59,8 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
                 const std::string& probe_name, SlfSettings settings, const fs::path& cache_dir,
                 const Reporter& reporter) {
   settings.bake.validate();
-  const meshes::Atlas atlas = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height);
+  const meshes::Atlas atlas =
+      meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
   const std::uint64_t rows = atlas.used_texels();
   const std::uint64_t end = settings.bake.end_row == 0 ? rows : settings.bake.end_row;
   const std::uint64_t count = end > settings.bake.first_row ? end - settings.bake.first_row : 0;
@@ -72,14 +73,16 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
   const std::size_t columns = 3 * std::size_t(settings.bake.grid.directions());
   {
     char line[320];
-    std::snprintf(line, sizeof line,
-                  "slf: %dx%d atlas, %llu of %llu texels used (%zu triangles); %llu rows x "
-                  "%d directions x %d spp, %d bounce(s); %s of radiance",
-                  atlas.width, atlas.height, static_cast<unsigned long long>(rows),
-                  static_cast<unsigned long long>(std::uint64_t(atlas.width) * atlas.height),
-                  mesh.triangles.size(), static_cast<unsigned long long>(count),
-                  settings.bake.grid.directions(), settings.bake.spp, settings.bake.bounces,
-                  common::format_bytes(count * columns * 4).c_str());
+    std::snprintf(
+        line, sizeof line,
+        "slf: %dx%d atlas (%d %s charts), %llu of %llu texels used (%zu triangles); %llu rows x "
+        "%d directions x %d spp, %d bounce(s); %s of radiance",
+        atlas.width, atlas.height, atlas.chart_count, meshes::kAtlasChartsNames.name(atlas.charts),
+        static_cast<unsigned long long>(rows),
+        static_cast<unsigned long long>(std::uint64_t(atlas.width) * atlas.height),
+        mesh.triangles.size(), static_cast<unsigned long long>(count),
+        settings.bake.grid.directions(), settings.bake.spp, settings.bake.bounces,
+        common::format_bytes(count * columns * 4).c_str());
     reporter.tell(line);
   }
   settings.bake.progress = [&reporter](std::uint64_t done, std::uint64_t total) {
@@ -101,6 +104,7 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
         matrix = prt::read_slf(run.bake_path);
         if (matrix.shape.mesh_hash != meshes::content_hash(mesh) ||
             matrix.shape.probe_hash != prt::probe_hash(probe) || matrix.shape.rows != rows ||
+            matrix.shape.charts != settings.charts ||
             matrix.shape.first_row != settings.bake.first_row || matrix.shape.row_count != count)
           throw prt::SlfFileError(run.bake_path.string() + ": not the bake its name says");
         run.bake_cached = true;

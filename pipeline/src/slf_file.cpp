@@ -18,7 +18,8 @@ constexpr common::VersionedFormat kSlfcFormat{"compressed surface light field fi
                                               "create it with prtr slf",
                                               "make it again with prtr slf",
                                               {'P', 'R', 'T', 'R', 'S', 'L', 'F', 'C'},
-                                              kSlfcFileVersion};
+                                              kSlfcFileVersion,
+                                              1};
 
 // Bytes 16-47, 56-91 and 112 hold the bake's settings as the .slf does (prt::put_slf_settings).
 constexpr std::size_t kSlfcOffRows = 48, kSlfcOffClusters = 92, kSlfcOffComponents = 96,
@@ -75,6 +76,7 @@ std::string slfc_problem(const CompressedSlf& slf) {
   if (b.atlas_width < 4 || b.atlas_width > 8192 || b.atlas_height < 4 || b.atlas_height > 8192)
     return "atlas size " + std::to_string(b.atlas_width) + " x " + std::to_string(b.atlas_height) +
            " is outside [4, 8192]";
+  if (std::string problem = prt::slf_charts_problem(b); !problem.empty()) return problem;
   try {
     b.grid.validate();
     b.material.validate();
@@ -176,6 +178,8 @@ CompressedSlf read_slfc(const std::filesystem::path& path) {
       b.rows > std::uint64_t(b.atlas_width) * std::uint64_t(b.atlas_height) || clusters < 1 ||
       clusters > b.rows || path_bytes > kMaxSlfcNameBytes || name_bytes > kMaxSlfcNameBytes)
     throw fail("header fields out of range" + damaged);
+  if (const std::string problem = prt::slf_charts_problem(b); !problem.empty())
+    throw fail("header field " + problem + damaged);
   if (const std::string problem = common::header_checksum_problem(h, kSlfcFormat); !problem.empty())
     throw fail(problem);
   // The rows stored are in the body; bound the size by the whole matrix first, then read the

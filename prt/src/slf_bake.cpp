@@ -34,21 +34,24 @@ constexpr common::VersionedFormat kSlfFormat{"surface light field file",
                                              "create it with prtr slf",
                                              "bake it again with prtr slf",
                                              {'P', 'R', 'T', 'R', 'S', 'L', 'F', 'M'},
-                                             kSlfFileVersion};
+                                             kSlfFileVersion,
+                                             1};
 
-constexpr std::size_t kSlfOffWidth = 16, kSlfOffHeight = 20, kSlfOffAzimuth = 24,
-                      kSlfOffElevation = 28, kSlfOffSpp = 32, kSlfOffBounces = 36, kSlfOffKind = 40,
-                      kSlfOffMasking = 44, kSlfOffSeed = 48, kSlfOffMeshHash = 56,
-                      kSlfOffAlbedo = 64, kSlfOffSpecular = 76, kSlfOffExponent = 80,
-                      kSlfOffRoughness = 84, kSlfOffF0 = 88, kSlfOffRows = 92, kSlfOffFirstRow = 96,
-                      kSlfOffRowCount = 100, kSlfOffPayloadChecksum = 104, kSlfOffProbeHash = 112;
+constexpr std::size_t kSlfOffWidth = 16, kSlfOffCharts = 18, kSlfOffHeight = 20,
+                      kSlfOffAzimuth = 24, kSlfOffElevation = 28, kSlfOffSpp = 32,
+                      kSlfOffBounces = 36, kSlfOffKind = 40, kSlfOffMasking = 44, kSlfOffSeed = 48,
+                      kSlfOffMeshHash = 56, kSlfOffAlbedo = 64, kSlfOffSpecular = 76,
+                      kSlfOffExponent = 80, kSlfOffRoughness = 84, kSlfOffF0 = 88, kSlfOffRows = 92,
+                      kSlfOffFirstRow = 96, kSlfOffRowCount = 100, kSlfOffPayloadChecksum = 104,
+                      kSlfOffProbeHash = 112;
 constexpr int kMaxSpp = 65536;
 constexpr float kSlfMaxRadiance = 1e20f;
 
 }  // namespace
 
 void put_slf_settings(common::VersionedHeader& h, const SlfShape& s) {
-  common::put_field(h, kSlfOffWidth, std::uint32_t(s.atlas_width));
+  common::put_field(h, kSlfOffWidth, std::uint16_t(s.atlas_width));
+  common::put_field(h, kSlfOffCharts, std::uint16_t(s.charts));
   common::put_field(h, kSlfOffHeight, std::uint32_t(s.atlas_height));
   common::put_field(h, kSlfOffAzimuth, std::uint32_t(s.grid.azimuth));
   common::put_field(h, kSlfOffElevation, std::uint32_t(s.grid.elevation));
@@ -69,7 +72,13 @@ void get_slf_settings(const common::VersionedHeader& h, SlfShape& s) {
   const auto count = [&h](std::size_t offset) {
     return int(std::min<std::uint32_t>(common::get_field<std::uint32_t>(h, offset), 1u << 30));
   };
-  s.atlas_width = count(kSlfOffWidth);
+  if (common::header_version(h) >= 2) {
+    s.atlas_width = common::get_field<std::uint16_t>(h, kSlfOffWidth);
+    s.charts = meshes::AtlasCharts(common::get_field<std::uint16_t>(h, kSlfOffCharts));
+  } else {
+    s.atlas_width = count(kSlfOffWidth);
+    s.charts = meshes::AtlasCharts::kPerTriangle;
+  }
   s.atlas_height = count(kSlfOffHeight);
   s.grid.azimuth = count(kSlfOffAzimuth);
   s.grid.elevation = count(kSlfOffElevation);
@@ -85,6 +94,12 @@ void get_slf_settings(const common::VersionedHeader& h, SlfShape& s) {
   s.material.roughness = common::get_field<float>(h, kSlfOffRoughness);
   s.material.f0 = common::get_field<float>(h, kSlfOffF0);
   s.probe_hash = common::get_field<std::uint64_t>(h, kSlfOffProbeHash);
+}
+
+std::string slf_charts_problem(const SlfShape& s) {
+  for (const auto& entry : meshes::kAtlasChartsNames.entries)
+    if (entry.value == s.charts) return {};
+  return "atlas chart method " + std::to_string(std::uint32_t(s.charts)) + " is unknown";
 }
 
 namespace {
@@ -109,6 +124,7 @@ std::string shape_problem(const SlfShape& s) {
   if (!in(std::uint64_t(s.atlas_width), 4, 8192) || !in(std::uint64_t(s.atlas_height), 4, 8192))
     return "atlas size " + std::to_string(s.atlas_width) + " x " + std::to_string(s.atlas_height) +
            " is outside [4, 8192]";
+  if (std::string problem = slf_charts_problem(s); !problem.empty()) return problem;
   if (!in(std::uint64_t(s.grid.azimuth), 1, 4096) || !in(std::uint64_t(s.grid.elevation), 1, 4096))
     return "direction grid " + std::to_string(s.grid.azimuth) + " x " +
            std::to_string(s.grid.elevation) + " is outside [1, 4096]";
@@ -252,6 +268,7 @@ SlfShape shape_of(const meshes::Mesh& mesh, const meshes::Atlas& atlas, const pr
   SlfShape s;
   s.atlas_width = atlas.width;
   s.atlas_height = atlas.height;
+  s.charts = atlas.charts;
   s.grid = o.grid;
   s.spp = o.spp;
   s.bounces = o.bounces;
@@ -418,11 +435,12 @@ SlfMatrix join_slf_parts(const std::vector<fs::path>& parts) {
     const SlfShape& s = read_parts[i].shape;
     const SlfShape& w = whole.shape;
     if (s.atlas_width != w.atlas_width || s.atlas_height != w.atlas_height ||
-        s.grid.azimuth != w.grid.azimuth || s.grid.elevation != w.grid.elevation ||
-        s.spp != w.spp || s.bounces != w.bounces || s.seed != w.seed ||
-        s.mesh_hash != w.mesh_hash || s.probe_hash != w.probe_hash || s.rows != w.rows ||
-        s.material.kind != w.material.kind || s.material.albedo != w.material.albedo ||
-        s.material.specular != w.material.specular || s.material.exponent != w.material.exponent ||
+        s.charts != w.charts || s.grid.azimuth != w.grid.azimuth ||
+        s.grid.elevation != w.grid.elevation || s.spp != w.spp || s.bounces != w.bounces ||
+        s.seed != w.seed || s.mesh_hash != w.mesh_hash || s.probe_hash != w.probe_hash ||
+        s.rows != w.rows || s.material.kind != w.material.kind ||
+        s.material.albedo != w.material.albedo || s.material.specular != w.material.specular ||
+        s.material.exponent != w.material.exponent ||
         s.material.roughness != w.material.roughness || s.material.f0 != w.material.f0 ||
         s.material.masking != w.material.masking) {
       throw SlfFileError(parts[i].string() + ": baked with other settings than " +

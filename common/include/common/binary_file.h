@@ -62,6 +62,9 @@ struct VersionedFormat {
   const char* remedy;  // "bake it again with prtr bake"
   std::array<char, 8> magic;
   std::uint32_t version;
+  // The oldest version the reader still accepts (it then reads the older layout itself);
+  // 0: only `version`.
+  std::uint32_t oldest_version = {};
 };
 
 // Zero bytes but the magic, version and header size; the format fills its own fields.
@@ -82,6 +85,9 @@ struct OpenedVersionedFile {
 };
 OpenedVersionedFile open_versioned(const std::filesystem::path& path,
                                    const VersionedFormat& format);
+
+// The format version the header records (open_versioned has checked it is one it reads).
+std::uint32_t header_version(const VersionedHeader& header);
 
 // Empty when the recorded header checksum matches.
 std::string header_checksum_problem(const VersionedHeader& header, const VersionedFormat& format);

@@ -4,7 +4,7 @@
 //
 // Cache: the bake's .slf goes to the cache directory (pipeline::default_cache_dir) as
 // slf-<hash>.slf, the hash (FNV-1a) over the mesh's content hash, the probe's hash, the atlas
-// size and every bake option; an entry is read in full, checksum included, before it is
+// size and charts and every bake option; an entry is read in full, checksum included, before it is
 // used, and one that fails is reported and baked again. The compression is not cached: at
 // the sizes the paper uses it costs a fraction of the bake.
 #pragma once
@@ -23,6 +23,7 @@ namespace pipeline {
 
 struct SlfSettings {
   int atlas_width = 256, atlas_height = 256;
+  meshes::AtlasCharts charts = meshes::AtlasCharts::kConformal;
   prt::SlfBakeOptions bake;        // its progress callback is replaced by the reporter's
   cpca::CompressOptions compress;  // its layout is set to the SLF's (pipeline/slf_file.h)
 };

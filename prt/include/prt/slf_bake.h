@@ -15,13 +15,15 @@
 // The .slf file holds the matrix (or a range of its rows, for processes that bake parts)
 // after a 128-byte versioned header (common/binary_file.h), little-endian:
 //   0 magic "PRTRSLFM", 8 u32 version, 12 u32 header bytes (128),
-//   16 u32 atlas width, 20 u32 atlas height, 24 u32 Z (azimuth cells), 28 u32 W (polar cells),
+//   16 u16 atlas width, 18 u16 atlas charts (meshes::AtlasCharts), 20 u32 atlas height,
+//   24 u32 Z (azimuth cells), 28 u32 W (polar cells),
 //   32 u32 spp, 36 u32 bounces, 40 u32 material kind, 44 u32 masking, 48 u64 seed,
 //   56 u64 mesh content hash, 64 f32[3] albedo, 76 f32 specular, 80 f32 exponent,
 //   84 f32 roughness, 88 f32 f0, 92 u32 rows of the whole matrix, 96 u32 first row stored,
 //   100 u32 rows stored, 104 u64 FNV-1a of the payload, 112 u64 FNV-1a of the probe's texels,
 //   120 u64 FNV-1a of bytes [0, 120),
-// then rows stored x 3 Z W float32, then nothing.
+// then rows stored x 3 Z W float32, then nothing. Version 1 (still read) had a u32 atlas
+// width at 16 and always per-triangle charts; its widths (at most 8192) left bytes 18-19 zero.
 #pragma once
 
 #include "common/binary_file.h"
@@ -40,7 +42,7 @@
 
 namespace prt {
 
-inline constexpr std::uint32_t kSlfFileVersion = 1;
+inline constexpr std::uint32_t kSlfFileVersion = 2;
 
 class SlfFileError : public std::runtime_error {
  public:
@@ -68,6 +70,8 @@ struct SlfBakeOptions {
 // Everything about a matrix but its values.
 struct SlfShape {
   int atlas_width = 0, atlas_height = 0;
+  // How the atlas was cut: meshes::make_atlas(mesh, width, height, {charts}) rebuilds it.
+  meshes::AtlasCharts charts = meshes::AtlasCharts::kConformal;
   SlfGrid grid;
   int spp = 0, bounces = 0;
   std::uint64_t seed = 0;
@@ -85,11 +89,14 @@ struct SlfMatrix {
 };
 
 // Both SLF files (.slf here, pipeline's .slfc) record the bake's settings in the same header
-// fields: bytes 16-47 (atlas size, grid, spp, bounces, material kind and masking), 56-91
-// (mesh hash, albedo, specular, exponent, roughness, f0) and 112 (probe hash). Reading
-// clamps counts to 2^30 so a hostile header cannot overflow an int; the caller validates.
+// fields: bytes 16-47 (atlas size and charts, grid, spp, bounces, material kind and masking),
+// 56-91 (mesh hash, albedo, specular, exponent, roughness, f0) and 112 (probe hash). Reading
+// clamps counts to 2^30 so a hostile header cannot overflow an int; the caller validates
+// (slf_settings_problem). A version 1 header (both files) reads as per-triangle charts.
 void put_slf_settings(common::VersionedHeader& header, const SlfShape& shape);
 void get_slf_settings(const common::VersionedHeader& header, SlfShape& shape);
+// Empty when the chart method is one make_atlas knows; else the problem, naming it.
+std::string slf_charts_problem(const SlfShape& shape);
 
 // The owned texels of the atlas in texel order: row r of the SLF matrix samples texel
 // slf_rows(atlas)[r] (y * width + x).
