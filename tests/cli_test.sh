@@ -156,6 +156,8 @@ errors=$(jget - /average_se /relative_error /clusters /method <<<"$out" | tr '\n
 run info "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --transfer "$tmp/cube.prtx" --verify
 expect_code 0 && [[ $out == *current* && $out != *STALE* ]]; check "info: .prtc current against its mesh and bake" $?
 run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: .prtc stale against another mesh" $?
+run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj" --json
+expect_code 1 && [[ $(jget - /format /checks/0/status <<<"$out" | tr '\n' ' ') == "prtc stale " ]]; check "info --json: .prtc stale against another mesh, as JSON" $?
 
 # An output never destroys an input, another output or a special file (common/output_path.h):
 # usage errors naming the flag, before any work, and the input is left as it was.
@@ -451,6 +453,22 @@ if [[ -f $forest ]]; then
   run slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/cube.slfc" --no-cache -q
   expect_code 0 && [[ $out == *"data generation"* && $out == *"compression ratio"* && $out == *"RMS error"* ]]; check "slf: exits 0 and reports times, ratio and error" $?
   [[ $(head -c 8 "$tmp/cube.slfc" 2>/dev/null) == PRTRSLFC ]]; check "slf writes a .slfc file" $?
+  # prtr info on both SLF files: the settings as made, and the compression ratio against its
+  # definition (V x 3 Z W raw floats over V N + K (N + 1) 3 Z W) from the rows it reports.
+  run info "$tmp/cube.slfc" --mesh "$tmp/cube.obj"
+  expect_code 0 && [[ $out =~ atlas\ +32\ x\ 32 && $out =~ directions\ +8\ x\ 4 && $out =~ clusters\ +4,\ 2\ PCs && $out =~ probe\ +forest.exr && $out == *"current against"* ]]; check "info: a .slfc's atlas, directions, clusters and probe ($err)" $?
+  run info "$tmp/cube.slfc" --json
+  read -r rows cols k pcs spp ratio < <(jget - /rows /columns /clusters /components /spp /compression_ratio <<<"$out" | tr '\n' ' ')
+  awk -v r="$rows" -v c="$cols" -v k="$k" -v n="$pcs" -v q="$ratio" 'BEGIN { e = r * c / (r * n + k * (n + 1) * c); exit !(c == 96 && k == 4 && n == 2 && r > 0 && q > 1 && (q - e) ^ 2 < 1e-12) }'
+  check "info --json: a .slfc's rows $rows x $cols, K $k, N $pcs, ratio $ratio" $?
+  [[ $spp == 2 && $(jget - /probe /format <<<"$out" | tr '\n' ' ') == "forest.exr slfc " ]]; check "info --json: a .slfc's spp, probe and format" $?
+  run info "$tmp/cube.slfc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: a .slfc stale against another mesh exits 1" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/cached.slfc" --cache "$tmp/slf_cache" -q
+  slfs=("$tmp"/slf_cache/slf-*.slf)
+  run info "${slfs[0]}" --json --verify
+  expect_code 0 && [[ $(jget - /format /rows /rows_stored /directions <<<"$out" | tr '\n' ' ') == "slf $rows $rows 32 " ]]; check "info --json: the raw bake (.slf) has the .slfc's rows ($err)" $?
+  head -c 300 "$tmp/cube.slfc" >"$tmp/cut.slfc"
+  run info "$tmp/cut.slfc"; expect_code 1 && [[ $err == *cut.slfc* ]]; check "info: a truncated .slfc exits 1 naming it" $?
   run slf "$tmp/cube.obj" --probe "$forest" --samples 4x4 -o "$tmp/x.slfc" --no-cache -q
   expect_code 2 && [[ $err == *"too small"* ]]; check "slf: an atlas too small for the mesh is a usage error" $?
   run slf "$tmp/cube.obj" --probe "$forest" --samples 32 -o "$tmp/x.slfc" -q
