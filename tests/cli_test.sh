@@ -29,6 +29,8 @@ media_info() {
   ffprobe -v error -count_frames -select_streams v:0 \
     -show_entries stream=width,height,nb_read_frames -of csv=p=0 "$1" 2>/dev/null
 }
+# rmse A.exr B.exr: prtr compare's relative RMSE of two images (0.0 when they are equal).
+rmse() { "$prtr" compare "$1" "$2" --json | jget - /relative_rmse; }
 have_matplotlib() { /usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1; }
 
 # Usage.
@@ -170,6 +172,8 @@ errors=$(jget - /average_se /relative_error /clusters /method <<<"$out" | tr '\n
 run info "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --transfer "$tmp/cube.prtx" --verify
 expect_code 0 && [[ $out == *current* && $out != *STALE* ]]; check "info: .prtc current against its mesh and bake" $?
 run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: .prtc stale against another mesh" $?
+run info "$tmp/cube.prtc" --mesh "$tmp/quad.obj" --json
+expect_code 1 && [[ $(jget - /format /checks/0/status <<<"$out" | tr '\n' ' ') == "prtc stale " ]]; check "info --json: .prtc stale against another mesh, as JSON" $?
 
 # An output never destroys an input, another output or a special file (common/output_path.h):
 # usage errors naming the flag, before any work, and the input is left as it was.
@@ -407,6 +411,18 @@ if [[ -f $forest ]]; then
   run relight "$tmp/cube.obj" --probe "$forest" --order 0; expect_code 2; check "relight: order 0 is a usage error" $?
   run relight "$tmp/cube.obj" --probe "$forest" --order 11; expect_code 2; check "relight: order 11 is a usage error" $?
   run relight "$tmp/cube.obj" --probe "$forest" --axis 0,0,0; expect_code 2 && [[ $err == *--axis* ]]; check "relight: zero axis is a usage error" $?
+  # --camera-orbit: the camera turns about --axis (default vertical) through the mesh's centre
+  # under fixed lighting, a quarter turn a frame here: frame 1 is prtr render of the same
+  # compressed set from the eye turned by 90 degrees (right-handed: (0,1,5) to (5,1,0)).
+  run relight "$tmp/cube.obj" --probe "$forest" --camera-orbit --eye 0,1,5 --order 2 --samples 32 --bounces 0 \
+    --clusters 2 --pcs 2 --frames 4 --width 32 --height 24 --background black --exr-pixels float \
+    --cache "$tmp/orbit_cache" --out "$tmp/orbit" --no-video -q
+  expect_code 0 && [[ $out == *"camera orbits"* ]]; check "relight --camera-orbit exits 0 ($err)" $?
+  orbit_set=("$tmp"/orbit_cache/cpca-*.prtc)
+  run render "${orbit_set[0]}" --probe "$forest" --mode decoupled --strategy greedy-refine --eye 5,1,0 \
+    --width 32 --height 24 --background black --frames 1 --warmup 0 -o "$tmp/orbit1.exr" -q
+  [[ $(rmse "$tmp/orbit/frame_0001.exr" "$tmp/orbit1.exr") == 0.0 ]]; check "relight --camera-orbit: frame 1 is the render from the turned eye" $?
+  [[ $(rmse "$tmp/orbit/frame_0000.exr" "$tmp/orbit1.exr") != 0.0 ]]; check "relight --camera-orbit: frame 0 differs from it" $?
 fi
 
 # JSON from every --json output, with names no JSON writer may pass through raw: a quote, a
@@ -465,6 +481,22 @@ if [[ -f $forest ]]; then
   run slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/cube.slfc" --no-cache -q
   expect_code 0 && [[ $out == *"data generation"* && $out == *"compression ratio"* && $out == *"RMS error"* ]]; check "slf: exits 0 and reports times, ratio and error" $?
   [[ $(head -c 8 "$tmp/cube.slfc" 2>/dev/null) == PRTRSLFC ]]; check "slf writes a .slfc file" $?
+  # prtr info on both SLF files: the settings as made, and the compression ratio against its
+  # definition (V x 3 Z W raw floats over V N + K (N + 1) 3 Z W) from the rows it reports.
+  run info "$tmp/cube.slfc" --mesh "$tmp/cube.obj"
+  expect_code 0 && [[ $out =~ atlas\ +32\ x\ 32 && $out =~ directions\ +8\ x\ 4 && $out =~ clusters\ +4,\ 2\ PCs && $out =~ probe\ +forest.exr && $out == *"current against"* ]]; check "info: a .slfc's atlas, directions, clusters and probe ($err)" $?
+  run info "$tmp/cube.slfc" --json
+  read -r rows cols k pcs spp ratio < <(jget - /rows /columns /clusters /components /spp /compression_ratio <<<"$out" | tr '\n' ' ')
+  awk -v r="$rows" -v c="$cols" -v k="$k" -v n="$pcs" -v q="$ratio" 'BEGIN { e = r * c / (r * n + k * (n + 1) * c); exit !(c == 96 && k == 4 && n == 2 && r > 0 && q > 1 && (q - e) ^ 2 < 1e-12) }'
+  check "info --json: a .slfc's rows $rows x $cols, K $k, N $pcs, ratio $ratio" $?
+  [[ $spp == 2 && $(jget - /probe /format <<<"$out" | tr '\n' ' ') == "forest.exr slfc " ]]; check "info --json: a .slfc's spp, probe and format" $?
+  run info "$tmp/cube.slfc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: a .slfc stale against another mesh exits 1" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/cached.slfc" --cache "$tmp/slf_cache" -q
+  slfs=("$tmp"/slf_cache/slf-*.slf)
+  run info "${slfs[0]}" --json --verify
+  expect_code 0 && [[ $(jget - /format /rows /rows_stored /directions <<<"$out" | tr '\n' ' ') == "slf $rows $rows 32 " ]]; check "info --json: the raw bake (.slf) has the .slfc's rows ($err)" $?
+  head -c 300 "$tmp/cube.slfc" >"$tmp/cut.slfc"
+  run info "$tmp/cut.slfc"; expect_code 1 && [[ $err == *cut.slfc* ]]; check "info: a truncated .slfc exits 1 naming it" $?
   run slf "$tmp/cube.obj" --probe "$forest" --samples 4x4 -o "$tmp/x.slfc" --no-cache -q
   expect_code 2 && [[ $err == *"too small"* ]]; check "slf: an atlas too small for the mesh is a usage error" $?
   run slf "$tmp/cube.obj" --probe "$forest" --samples 32 -o "$tmp/x.slfc" -q
@@ -478,6 +510,32 @@ if [[ -f $forest ]]; then
   expect_code 2 && [[ $err == *--rotate-deg* && $err == *"surface light field"* ]]; check "render: --rotate-deg on a .slfc is a usage error naming it" $?
   run render "$tmp/cube.slfc" --probe "${forest%forest.exr}city.exr" -o "$tmp/x.exr" -q
   expect_code 2 && [[ $err == *--probe* && $err == *forest.exr* ]]; check "render: a .slfc under another probe is a usage error naming the baked one" $?
+  # prtr relight --kind slf: prtr slf's cached pipeline, the camera orbiting the mesh; frame 0
+  # is prtr render of the .slfc prtr slf makes with the same settings (the same cached bake),
+  # frame 1 the render from the eye turned by a quarter turn; all of relight's outputs.
+  slf_settings=(--directions 8x4 --spp 2 --clusters 4 --pcs 2 --cache "$tmp/slf_cache")
+  run relight "$tmp/cube.obj" --probe "$forest" --kind slf --camera-orbit --slf-samples 32x32 "${slf_settings[@]}" \
+    --eye 0,1,5 --frames 4 --width 32 --height 24 --background black --exr-pixels float --out "$tmp/slfrl" -q
+  expect_code 0 && [[ $out == *"render      slf"* && $out == *"bake        cached"* ]]; check "relight --kind slf exits 0, its bake cached by prtr slf ($err)" $?
+  for f in frame_0000.exr frame_0003.exr frame_0003.png contact_sheet.png relight.gif; do
+    [[ -s $tmp/slfrl/$f ]]; check "relight --kind slf wrote $f" $?
+  done
+  if command -v ffprobe >/dev/null; then
+    info=$(media_info "$tmp/slfrl/relight.mp4"); [[ $info == 32,24,4 ]]; check "relight --kind slf: MP4 is 32 x 24, 4 frames ($info)" $?
+  fi
+  "$prtr" slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 "${slf_settings[@]}" -o "$tmp/orbit.slfc" -q >/dev/null
+  slf_render=(render "$tmp/orbit.slfc" --probe "$forest" --width 32 --height 24 --background black --frames 1 --warmup 0 -q)
+  "$prtr" "${slf_render[@]}" --eye 0,1,5 -o "$tmp/slf0.exr"
+  "$prtr" "${slf_render[@]}" --eye 5,1,0 -o "$tmp/slf1.exr"
+  [[ $(rmse "$tmp/slfrl/frame_0000.exr" "$tmp/slf0.exr") == 0.0 ]]; check "relight --kind slf: frame 0 equals prtr render of the .slfc" $?
+  [[ $(rmse "$tmp/slfrl/frame_0001.exr" "$tmp/slf1.exr") == 0.0 ]]; check "relight --kind slf: frame 1 equals the render from the turned eye" $?
+  [[ $(rmse "$tmp/slfrl/frame_0000.exr" "$tmp/slf1.exr") != 0.0 ]]; check "relight --kind slf: the frames differ" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --kind slf --out "$tmp/x"
+  expect_code 2 && [[ $err == *--camera-orbit* ]]; check "relight --kind slf without --camera-orbit (a turning environment) is a usage error naming it" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --kind slf --camera-orbit --mode cpu --out "$tmp/x"
+  expect_code 2 && [[ $err == *--mode* ]]; check "relight --kind slf: a PRT flag is a usage error naming it" $?
+  run relight "$tmp/cube.obj" --probe "$forest" --spp 4 --out "$tmp/x"
+  expect_code 2 && [[ $err == *--spp* ]]; check "relight: an SLF flag without --kind slf is a usage error naming it" $?
   # prtr compare: an image against itself is exact; against the path-traced one it is not.
   run compare "$tmp/slf.exr" "$tmp/slf.exr" --json
   expect_code 0 && [[ $out == *'"relative_rmse":0'* ]]; check "compare: an image against itself has no error" $?

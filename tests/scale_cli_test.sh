@@ -4,8 +4,8 @@
 #           prtr --threads 1 equals every core (bake with a bounce, compress).
 #   mpi     mpirun -np 2 and -np 3 (oversubscribed, localhost only) prtr bake (0, 1 or 2
 #           bounces) and prtr compress equal the one-process results byte for byte; a failing
-#           rank fails the job and leaves no output. Exit 77
-#           (skip) when prtr was built without MPI.
+#           rank fails the job and leaves no output; mpirun -np 5 prtr slf equals one process
+#           too. Exit 77 (skip) when prtr was built without MPI.
 # Usage: scale_cli_test.sh blocks|mpi PRTR TMPDIR [MPIEXEC]
 set -u
 mode=$1
@@ -155,4 +155,27 @@ grep -q "method lbg" "$tmp/it.log"; check "the refusal says what runs" $?
 mpi 2 "${compress[@]}" -o "$tmp/no_such_dir/x.prtc" >"$tmp/cfail.log" 2>&1
 [[ $? != 0 ]]; check "a compress whose rank 0 cannot write fails the job" $?
 grep -q "rank 0 of 2" "$tmp/cfail.log"; check "the failing compress rank is named" $?
+
+# prtr slf: each rank path traces its range of the matrix's rows into OUT.part<r>, rank 0 joins
+# them and compresses; every row's random numbers are its own, so the file is the one-process
+# file byte for byte (5 ranks: the cube's 516 rows split unevenly). The cube under a small generated sky (Radiance
+# RGBE, flat scanlines: a gradient in every channel, so each row of the matrix differs).
+sky=$tmp/sky.hdr
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 32\n'
+  LC_ALL=C awk 'BEGIN { for (y = 0; y < 16; ++y) for (x = 0; x < 32; ++x)
+                          printf "%c%c%c%c", 64 + 8 * y, 64 + 4 * x, 160 - 4 * y, 129 }'; } >"$sky"
+printf 'v -1 -1 -1\nv 1 -1 -1\nv 1 1 -1\nv -1 1 -1\nv -1 -1 1\nv 1 -1 1\nv 1 1 1\nv -1 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n' >"$tmp/cube.obj"
+slf=(slf "$tmp/cube.obj" --probe "$sky" --samples 30x30 --directions 8x4 --spp 2 --clusters 6 --pcs 2 --no-cache -q)
+"$prtr" "${slf[@]}" -o "$tmp/one.slfc" >/dev/null; check "one-process slf" $?
+mpi 5 "${slf[@]}" -o "$tmp/mpi5.slfc" >"$tmp/slf5.log" 2>&1; check "mpirun -np 5 slf exits 0" $?
+cmp "$tmp/one.slfc" "$tmp/mpi5.slfc"; check "mpirun -np 5 slf equals one process" $?
+left=$(ls "$tmp" | grep -c '\.part[0-9]*$')
+[[ $left == 0 ]]; check "no .part files left after mpirun slf" $?
+# A rank that cannot write its part (a directory in the way) fails the job, with no output.
+mkdir -p "$tmp/fail.slfc.part1"
+mpi 2 "${slf[@]}" -o "$tmp/fail.slfc" >"$tmp/slffail.log" 2>&1
+[[ $? != 0 && ! -e $tmp/fail.slfc ]]; check "a failing slf rank fails the job, no output" $?
+grep -q "rank 1 of 2" "$tmp/slffail.log"; check "the failing slf rank is named" $?
+mpi 2 "${slf[@]}" --rows 0:100 -o "$tmp/rows.slfc" >"$tmp/slfrows.log" 2>&1
+[[ $? == 2 ]] && grep -q -- "--rows" "$tmp/slfrows.log"; check "mpirun slf --rows is a usage error naming it" $?
 exit $((failed > 0))

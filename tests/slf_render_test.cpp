@@ -228,6 +228,24 @@ TEST(SlfReference, EachTexelUsesItsOwnClusterAndUnusedTexelsWeighNothing) {
   EXPECT_NEAR(render::slf_radiance(m, {3.0f / 4, 3.5f / 4}, Vector3d::UnitY()).x(), 0.5 * 3, 1e-6);
 }
 
+// Negative reconstructions are clamped to 0 per channel after the spatial blend: two texels
+// of two clusters (k = 0) whose red is -1 and 3 give 1 halfway (a clamp of each texel
+// first would give 1.5), 0 a fifth of the way (-1 * 0.8 + 3 * 0.2 = -0.2) with green
+// untouched, and 0 over the negative texel itself.
+TEST(SlfReference, NegativeRadianceIsClampedAfterTheSpatialBlend) {
+  render::SlfModel m = one_quad_model(2, 1, {4, 2}, 0, 2);
+  fill_maps(
+      m, [](int x, int) { return x; }, [](int, int, int) { return 0.f; },
+      [](int c, int, int, int, int ch) { return ch == 0 ? (c ? 3.f : -1.f) : 0.5f; });
+  m.validate();
+  const float y = 0.5f;
+  EXPECT_NEAR(render::slf_radiance(m, {0.5f, y}, Vector3d::UnitY()).x(), 1.0, 1e-6);
+  const Vector3f near_negative = render::slf_radiance(m, {(0.5f + 0.2f) / 2, y}, Vector3d::UnitY());
+  EXPECT_EQ(near_negative.x(), 0.f);  // -1 * 0.8 + 3 * 0.2 = -0.2
+  EXPECT_NEAR(near_negative.y(), 0.5, 1e-6);
+  EXPECT_EQ(render::slf_radiance(m, {0.f, y}, Vector3d::UnitX()).x(), 0.f);
+}
+
 // --- From the compression's output --------------------------------------------------------
 
 // A hand-made atlas of two triangles on a 4 x 3 map with unused texels between, a 4 x 4 grid
@@ -278,7 +296,7 @@ TEST(SlfFromCompressed, RowsAreTheOwnedTexelsInOrder) {
     for (int column = 0; column < grid.directions(); ++column) {
       const Vector3f got = render::slf_radiance(m, centre, prt::slf_grid_direction(grid, column));
       for (int ch = 0; ch < 3; ++ch)
-        EXPECT_NEAR(got[ch], row[std::size_t(column) * 3 + std::size_t(ch)], 1e-5)
+        EXPECT_NEAR(got[ch], std::max(row[std::size_t(column) * 3 + std::size_t(ch)], 0.f), 1e-5)
             << "texel " << t << " direction " << column;
     }
     ++r;
@@ -332,6 +350,18 @@ render::SlfModel scene_model() {
         return float(base * (1.0 + 0.3 * std::sin(a + 0.5 * c + s + ch) + 0.4 * p * (ch + 1)) +
                      0.05 * i * (s == k));
       });
+  m.validate();
+  return m;
+}
+
+// The scene with red lowered by 1.5 in every cluster mean: the reconstruction's red is
+// negative over part of each quad (a smooth function, so exactly 0 only where clamped).
+render::SlfModel negative_scene_model() {
+  render::SlfModel m = scene_model();
+  const std::size_t slice = m.slice_floats();
+  for (int c = 0; c < m.clusters; ++c)
+    for (std::size_t d = 0; d < slice; d += 3)
+      m.view_maps[std::size_t(c) * std::size_t(m.components + 1) * slice + d] -= 1.5f;
   m.validate();
   return m;
 }
@@ -412,6 +442,52 @@ TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnEveryPathAndAtThePoles) {
       EXPECT_FLOAT_EQ(gl.pixel(0, 0)[2], 0.3f) << label;
       EXPECT_EQ(gl.pixel(0, 0)[3], 0.f) << label;
     }
+  }
+}
+
+// Where the reconstruction goes negative, both renderers clamp it to 0 at the same point:
+// every pixel is >= 0, a good share of the covered pixels have red exactly 0 (it is never
+// 0 by accident in a smooth field), and GL still matches the CPU reference on every path.
+TEST(SlfRenderer, NegativeReconstructionRendersClampedOnBothPaths) {
+  render::GlContext ctx;
+  const render::SlfModel model = negative_scene_model();
+  render::Camera camera;
+  camera.eye = {0.15, 0.1, 3.2};
+  camera.width = 64;
+  camera.height = 48;
+  camera.near_plane = 0.5;
+  camera.far_plane = 10;
+  const render::Image cpu = render::render_slf_reference(model, camera);
+  struct Counts {
+    int negative = 0, zero_red = 0, covered = 0;
+  };
+  auto count = [](const render::Image& image) {
+    Counts n;
+    for (std::size_t i = 0; i < image.rgba.size(); i += 4) {
+      for (int ch = 0; ch < 3; ++ch) n.negative += image.rgba[i + std::size_t(ch)] < 0.f;
+      if (image.rgba[i + 3] != 1.f) continue;
+      ++n.covered;
+      n.zero_red += image.rgba[i] == 0.f;
+    }
+    return n;
+  };
+  const Counts on_cpu = count(cpu);
+  EXPECT_EQ(on_cpu.negative, 0);
+  EXPECT_GT(on_cpu.zero_red, on_cpu.covered / 10);
+  EXPECT_LT(on_cpu.zero_red, on_cpu.covered * 9 / 10);
+  render::Background background;
+  background.use_probe = false;
+  for (int variant = 0; variant < 4; ++variant) {
+    const bool fast = variant % 2 == 0, deferred = variant >= 2;
+    render::SlfRenderer renderer(model, nullptr, {true, fast, deferred});
+    renderer.set_background(background);
+    renderer.render(camera);
+    const render::Image gl = renderer.read_image();
+    const Counts on_gl = count(gl);
+    EXPECT_EQ(on_gl.negative, 0) << "variant " << variant;
+    EXPECT_NEAR(on_gl.zero_red, on_cpu.zero_red, kEdgePixels) << "variant " << variant;
+    const Comparison c = compare(gl, cpu, kImageTolerance);
+    EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels) << "variant " << variant;
   }
 }
 

@@ -20,11 +20,18 @@ Eigen::Vector3f parse_albedo(const std::string& text) {
 
 }  // namespace
 
-void add_bake_flags(CLI::App* cmd, BakeFlags& f) {
+void add_bake_flags(CLI::App* cmd, BakeFlags& f, bool with_slf) {
   f.command = cmd;
-  cmd->add_option("--kind", f.kind, "diffuse: transfer vectors; glossy: transfer matrices")
-      ->check(CLI::IsMember({"diffuse", "glossy"}))
-      ->capture_default_str();
+  if (with_slf)
+    cmd->add_option("--kind", f.kind,
+                    "diffuse: transfer vectors; glossy: transfer matrices; slf: a surface light "
+                    "field (fixed lighting, prtr slf's pipeline)")
+        ->check(CLI::IsMember({"diffuse", "glossy", "slf"}))
+        ->capture_default_str();
+  else
+    cmd->add_option("--kind", f.kind, "diffuse: transfer vectors; glossy: transfer matrices")
+        ->check(CLI::IsMember({"diffuse", "glossy"}))
+        ->capture_default_str();
   add_checked_option(cmd, "--order", f.bake.order, "SH order N (N^2 coefficients)",
                      integer_in(1, 10));
   add_checked_option(cmd, "--samples", f.bake.samples, "Hemisphere directions per vertex",

@@ -31,7 +31,9 @@ struct BakeFlags {
   CLI::App* command = nullptr;  // to tell which flags were given
 };
 
-void add_bake_flags(CLI::App* command, BakeFlags& flags);
+// `with_slf`: --kind also takes slf (prtr relight: a surface light field instead of PRT),
+// which resolve_bake_flags does not resolve; the command reads the flags it shares itself.
+void add_bake_flags(CLI::App* command, BakeFlags& flags, bool with_slf = false);
 
 // The options the flags describe, validated; UsageError naming the flag otherwise (also for
 // a material parameter the chosen material never reads).

@@ -1,8 +1,10 @@
 // prtr relight MESH --probe PROBE: the whole pipeline in one command. Bakes and compresses
 // through the cache (a second run with the same inputs skips both), then renders a frame
 // sequence while the environment turns about an axis (SH rotation per frame, no
-// re-projection), writing EXR frames, PNG previews, a contact sheet, an animated GIF and,
-// when ffmpeg is installed, an MP4.
+// re-projection), or with --camera-orbit while the camera turns about the mesh under fixed
+// lighting, writing EXR frames, PNG previews, a contact sheet, an animated GIF and, when
+// ffmpeg is installed, an MP4. --kind slf makes a surface light field instead (prtr slf's
+// cached pipeline) and orbits the camera around it: its lighting is baked.
 #include "animation.h"
 #include "bake_flags.h"
 #include "commands.h"
@@ -13,8 +15,10 @@
 #include "flag_checks.h"
 #include "gl_flags.h"
 #include "mesh_flags.h"
+#include "meshes/atlas.h"
 #include "meshes/load.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/slf.h"
 #include "probes/load.h"
 #include "progress_bar.h"
 #include "prt/projection.h"
@@ -24,7 +28,10 @@
 #include "render/image.h"
 #include "render/pass_grouping.h"
 #include "render/renderer.h"
+#include "render/slf_from_compressed.h"
+#include "render/slf_renderer.h"
 #include "render/supersample.h"
+#include "slf_flags.h"
 #include "supersample_flag.h"
 #include "view_flags.h"
 
@@ -33,6 +40,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -79,10 +87,11 @@ struct Options {
   CompressFlags compress;
   GlFlags gl;
   MeshFlags mesh_flags;
+  SlfFlags slf;  // --kind slf
   int frames = 24, columns = 6, thumbnail = 320, fps = 24, register_budget = 0, gif_width = 640;
   int supersample = kDefaultSupersample;
   double degrees = 360.0;
-  bool quiet = false, no_video = false;
+  bool quiet = false, no_video = false, camera_orbit = false;
   std::string exr_pixels = "half", accumulation = "auto", constants = "auto";
 };
 
@@ -91,8 +100,13 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("--out", o.out, "Output directory")->capture_default_str();
   add_checked_option(cmd, "--frames", o.frames, "Frames in the sequence", integer_in(1, 100000));
-  add_checked_option(cmd, "--degrees", o.degrees, "Total environment rotation over the sequence",
+  add_checked_option(cmd, "--degrees", o.degrees,
+                     "Total rotation over the sequence: the environment's, or the camera's "
+                     "with --camera-orbit",
                      angle_degrees());
+  cmd->add_flag("--camera-orbit", o.camera_orbit,
+                "The camera turns about --axis through the mesh's centre while the lighting "
+                "stays fixed (instead of the environment turning); needed by --kind slf");
   add_checked_option(cmd, "--mode", o.mode, "Rendering path (render/renderer.h)",
                      CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu"}));
   cmd->add_option("--strategy", o.strategy, "Super-cluster strategy for multipass/decoupled")
@@ -102,7 +116,8 @@ void add_flags(CLI::App* cmd, Options& o) {
       ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
-  add_bake_flags(cmd, o.bake);
+  add_bake_flags(cmd, o.bake, true);
+  add_slf_flags(cmd, o.slf, "--slf-samples");
   add_mesh_flags(cmd, o.mesh_flags);
   add_view_flags(cmd, o.view);
   add_supersample_flag(cmd, o.supersample);
@@ -232,14 +247,23 @@ int writer_threads() {
   return std::clamp(int(std::thread::hardware_concurrency()), 2, 8);
 }
 
-// The sequence: EXR and PNG per frame, written while the next frames render. `camera` is the
-// supersampled one; each frame is box-filtered down to the requested size before it is
-// queued.
-FrameTimes render_frames(const Options& o, render::Renderer& renderer, const render::Camera& camera,
-                         const prt::ShLighting& lighting, Previews& previews) {
-  const Eigen::Vector3d axis = resolve_axis(o.view);
-  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
-  for (int i = 0; i < 2; ++i) renderer.render(camera, lighting, identity);  // warm-up
+// One frame of the sequence at the supersampled size, drawn; then its samples, read.
+struct FrameSource {
+  std::function<render::FrameTiming(int frame)> draw;
+  std::function<void(render::Image& samples)> read;
+};
+
+// Frame f's angle: --degrees over the sequence, the last frame one step short of it (so a
+// full turn loops).
+double frame_radians(const Options& o, int f) {
+  return o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
+}
+
+// The sequence: EXR and PNG per frame, written while the next frames render. The source
+// draws at the supersampled size; each frame is box-filtered down to the requested size
+// before it is queued.
+FrameTimes render_frames(const Options& o, const FrameSource& source, Previews& previews) {
+  for (int i = 0; i < 2; ++i) source.draw(0);  // warm-up
   remove_old_frames(o.out);
   ProgressBar bar(o.quiet);
   FrameTimes times;
@@ -251,12 +275,11 @@ FrameTimes render_frames(const Options& o, render::Renderer& renderer, const ren
   render::Image samples;
   for (int f = 0; f < o.frames; ++f) {
     bar.update("rendering frames", std::uint64_t(f), std::uint64_t(o.frames));
-    const double angle = o.degrees * double(f) / double(o.frames) * std::numbers::pi / 180.0;
-    const render::FrameTiming t = renderer.render(camera, lighting, prt::axis_angle(axis, angle));
+    const render::FrameTiming t = source.draw(f);
     times.frame_ms.push_back(t.total_ms);
     times.gl_ms.push_back(t.gl_ms);
     times.cpu_ms.push_back(t.cpu_ms);
-    renderer.read_image(samples);
+    source.read(samples);
     const auto filter_start = Clock::now();
     auto image = std::make_shared<const render::Image>(
         o.supersample == 1 ? samples : render::box_downsample(samples, o.supersample));
@@ -286,14 +309,27 @@ std::string make_animations(const Options& o, const Previews& previews) {
   return gif.string() + "; no MP4: ffmpeg reported an error";
 }
 
-void print_summary(const Options& o, const render::RenderStats& st, const render::Camera& camera,
+// The sequence's motion, as the "motion" line says it.
+std::string motion(const Options& o) {
+  char degrees[64];
+  std::snprintf(degrees, sizeof degrees, " %g degrees about (", o.degrees);
+  std::string text = o.camera_orbit ? "camera orbits the mesh's centre," : "environment turns";
+  text += degrees;
+  text += o.view.axis;
+  text += ") over ";
+  text += std::to_string(o.frames);
+  text += " frames";
+  return text;
+}
+
+// `render_line`: what drew the frames (the "render" line's text).
+void print_summary(const Options& o, const std::string& render_line, const render::Camera& camera,
                    const FrameTimes& t, const std::string& video, const fs::path& sheet,
                    double total_s) {
-  std::printf(
-      "render      %s, %d pass(es), average overdraw %.3f, %d x %d (%d x %d samples per "
-      "pixel: %d x %d rendered)\n",
-      o.mode.c_str(), st.passes, st.average_overdraw, camera.width, camera.height, o.supersample,
-      o.supersample, camera.width * o.supersample, camera.height * o.supersample);
+  std::printf("render      %s, %d x %d (%d x %d samples per pixel: %d x %d rendered)\n",
+              render_line.c_str(), camera.width, camera.height, o.supersample, o.supersample,
+              camera.width * o.supersample, camera.height * o.supersample);
+  std::printf("motion      %s\n", motion(o).c_str());
   std::printf(
       "frames      %d in %s: %.2f ms per frame median (%.1f FPS; CPU update %.2f ms, "
       "GL %.2f ms), %.2f s with EXR/PNG output\n",
@@ -306,11 +342,107 @@ void print_summary(const Options& o, const render::RenderStats& st, const render
   std::printf("contact sheet: %s\n", sheet.string().c_str());
 }
 
-void run(const Options& o, CLI::App*) {
+// The frames through `source`, then the contact sheet, the animations and the summary.
+void render_outputs(const Options& o, const render::Camera& camera, const FrameSource& source,
+                    const std::string& render_line, Clock::time_point start) {
+  Previews previews = make_previews(o, camera);
+  const FrameTimes times = render_frames(o, source, previews);
+  const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
+  render::write_png(sheet, tile(previews.thumbnails, o.columns), o.view.exposure);
+  const std::string video = make_animations(o, previews);
+  print_summary(o, render_line, camera, times, video, sheet, seconds_since(start));
+}
+
+// Flags of one kind given with the other: usage errors naming the flag.
+void check_kind_flags(const Options& o, const CLI::App* cmd) {
+  const bool slf = o.bake.kind == "slf";
+  if (slf) {
+    for (const char* flag : {"--mode", "--strategy", "--register-budget", "--accumulation",
+                             "--constants", "--order", "--samples", "--view-fit", "--ray-offset"})
+      if (cmd->count(flag))
+        throw UsageError(std::string(flag) +
+                         " applies to PRT (--kind diffuse or glossy); a surface light field "
+                         "(--kind slf) renders in one pass from its own bake (atlas size: "
+                         "--slf-samples)");
+    if (!o.camera_orbit)
+      throw UsageError(
+          "--kind slf needs --camera-orbit: a surface light field's lighting is baked, so "
+          "the environment cannot turn; the camera orbits the mesh instead");
+  } else {
+    for (const char* flag : {"--slf-samples", "--charts", "--directions", "--spp"})
+      if (cmd->count(flag))
+        throw UsageError(std::string(flag) + " applies to --kind slf (a surface light field)");
+  }
+}
+
+// --kind slf: prtr slf's pipeline (the bake cached as prtr slf caches it), then the camera's
+// orbit drawn by the one-pass SLF renderer, with the probe as the unturned background.
+void run_slf(const Options& o, Clock::time_point start) {
+  pipeline::SlfSettings settings;
+  resolve_slf_flags(o.slf, settings);
+  settings.bake.bounces = o.bake.bake.bounces;
+  settings.bake.seed = o.bake.bake.seed;
+  settings.bake.material = resolve_material_flags(o.bake.material);
+  settings.compress = resolve_compress_flags(o.compress);
+  if (settings.compress.alpha > 0 || settings.compress.overdraw_reduction)
+    throw UsageError(
+        "--alpha and --overdraw-reduction need mesh vertices; a surface light field's rows "
+        "are atlas texels");
+  try {
+    settings.bake.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  const Eigen::Vector3d axis = resolve_axis(o.view);
+  const render::Background background = resolve_background(o.view);
+  const render::GlSelection gl = gl_selection(o.gl);
+  const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
+  const render::Camera camera = resolve_camera(o.view, mesh);
+  const probes::Probe probe = probes::load_probe(o.probe);
+  make_output_directory(o.out);
+  const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
+  pipeline::SlfRun r;
+  try {
+    r = pipeline::make_slf(mesh, o.mesh, probe, fs::path(o.probe).filename().string(), settings,
+                           cache, stderr_reporter(o.quiet));
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());  // an atlas too small for the mesh, too many clusters
+  }
+  std::printf("bake        %s %s (%.1f s)\n", r.bake_cached ? "cached" : "baked",
+              r.bake_path.string().c_str(), r.bake_seconds);
+  std::printf(
+      "compress    compressed %d cluster(s), %d PC(s): ratio %.1f, RMS error %.3g%% (%.1f s)\n",
+      r.slf.set.cluster_count, r.slf.set.component_count, r.ratio, 100 * r.relative_rms_error,
+      r.compress_seconds);
+  const meshes::Atlas atlas = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height);
+  const render::SlfModel model =
+      render::slf_model_from_compressed(mesh, atlas, r.slf.bake.grid, r.slf.set);
+
+  render::GlContext context(gl);
+  render::SlfRendererOptions ro;
+  // As prtr render draws a .slfc (the same image): the deferred pass on a software rasteriser.
+  ro.deferred = context.info().software_rasterizer();
+  render::SlfRenderer renderer(model, &probe, ro);
+  renderer.set_background(background);
+  const render::Camera big = render::supersampled(camera, o.supersample);
+  const Eigen::Vector3d centre = mesh_centre(mesh);
+  const FrameSource source{
+      [&](int f) { return renderer.render(orbit_camera(big, centre, axis, frame_radians(o, f))); },
+      [&](render::Image& samples) { renderer.read_image(samples); }};
+  char line[200];
+  std::snprintf(line, sizeof line, "slf, %s, %d x %d texels, %d x %d directions",
+                ro.deferred ? "one shading pass after a uv pass" : "one pass", model.map_width,
+                model.map_height, model.grid.azimuth, model.grid.elevation);
+  render_outputs(o, camera, source, line, start);
+}
+
+void run(const Options& o, CLI::App* cmd) {
   const auto start = Clock::now();
+  check_kind_flags(o, cmd);
+  if (o.bake.kind == "slf") return run_slf(o, start);
   const prt::BakeOptions bake = resolve_bake_flags(o.bake);
   const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
-  resolve_axis(o.view);
+  const Eigen::Vector3d axis = resolve_axis(o.view);
   resolve_background(o.view);
   const render::GlSelection gl = gl_selection(o.gl);
   check_sizes(bake, compress);
@@ -325,18 +457,30 @@ void run(const Options& o, CLI::App*) {
   const prt::ShLighting lighting = prt::project(probe, set.order);
   render::GlContext context(gl);
   const auto renderer = make_renderer(o, mesh, set, probe, context);
-  Previews previews = make_previews(o, camera);
-  const FrameTimes times =
-      render_frames(o, *renderer, render::supersampled(camera, o.supersample), lighting, previews);
-  const fs::path sheet = fs::path(o.out) / "contact_sheet.png";
-  render::write_png(sheet, tile(previews.thumbnails, o.columns), o.view.exposure);
-  const std::string video = make_animations(o, previews);
-  print_summary(o, renderer->stats(), camera, times, video, sheet, seconds_since(start));
+  const render::Camera big = render::supersampled(camera, o.supersample);
+  const Eigen::Vector3d centre = mesh_centre(mesh);
+  const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
+  const FrameSource source{[&](int f) {
+                             const double angle = frame_radians(o, f);
+                             if (o.camera_orbit)
+                               return renderer->render(orbit_camera(big, centre, axis, angle),
+                                                       lighting, identity);
+                             return renderer->render(big, lighting, prt::axis_angle(axis, angle));
+                           },
+                           [&](render::Image& samples) { renderer->read_image(samples); }};
+  // Drawn once before the frames, for the statistics the render line reports.
+  source.draw(0);
+  const render::RenderStats st = renderer->stats();
+  char line[200];
+  std::snprintf(line, sizeof line, "%s, %d pass(es), average overdraw %.3f", o.mode.c_str(),
+                st.passes, st.average_overdraw);
+  render_outputs(o, camera, source, line, start);
 }
 
 constexpr const char* kAbout =
-    "Bake, compress (cached) and render MESH under PROBE as it rotates: EXR frames, PNG "
-    "previews, a contact sheet, an animated GIF and an MP4 (ffmpeg)";
+    "Bake, compress (cached) and render MESH under PROBE as it rotates (or as the camera "
+    "orbits; --kind slf: a surface light field): EXR frames, PNG previews, a contact sheet, an "
+    "animated GIF and an MP4 (ffmpeg)";
 
 }  // namespace cmd_relight
 

@@ -3,14 +3,17 @@
 // triangle as files of version 1 had), the exit radiance of every texel toward --directions
 // cells path traced under the probe (cached), CPCA of that matrix, and the figures the
 // paper's Table 1 reports: data generation time, compression time, compression ratio, and
-// the RMS error of the compressed matrix against the baked one.
+// the RMS error of the compressed matrix against the baked one. Under mpirun the ranks bake
+// row ranges and rank 0 compresses: the same file as one process.
 #include "bake_flags.h"
 #include "commands.h"
 #include "common/json.h"
 #include "compress_flags.h"
 #include "flag_checks.h"
 #include "mesh_flags.h"
+#include "mpi_world.h"
 #include "progress_bar.h"
+#include "slf_flags.h"
 
 #include "meshes/atlas.h"
 #include "meshes/load.h"
@@ -18,9 +21,12 @@
 #include "pipeline/slf.h"
 #include "probes/load.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace prtr_app {
 using common::dump_json;
@@ -31,29 +37,16 @@ namespace cmd_slf {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string mesh, probe, output, cache,
-      samples = "256x256", directions = "32x16", rows,
-      charts = meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal);
+  std::string mesh, probe, output, cache, rows;
+  SlfFlags slf;
   MaterialFlags material;
   MeshFlags mesh_flags;
   CompressFlags compress;
-  int spp = 16, bounces = 1;
+  int bounces = 1;
   std::uint64_t seed = 1;
   double ray_offset = 1e-4;
   bool quiet = false, json = false, no_cache = false;
 };
-
-// "AxB" with both in [lo, hi]; UsageError naming the flag otherwise.
-std::pair<int, int> parse_size(const std::string& text, const char* flag, int lo, int hi) {
-  int a = 0, b = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
-      a < lo || a > hi || b < lo || b > hi) {
-    throw UsageError(std::string(flag) + " " + text + ": expected WxH with both in [" +
-                     std::to_string(lo) + ", " + std::to_string(hi) + "] (e.g. 256x256)");
-  }
-  return {a, b};
-}
 
 // "A:B" as rows [A, B); {0, 0} for all rows.
 std::pair<std::uint64_t, std::uint64_t> parse_rows(const std::string& text) {
@@ -72,18 +65,7 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_option("--probe", o.probe, "Light probe (lat-long or angular EXR/HDR)")->required();
   cmd->add_option("-o,--output", o.output, "Compressed surface light field to write (.slfc)")
       ->required();
-  cmd->add_option("--samples", o.samples, "Atlas size WxH in texels: the surface samples")
-      ->capture_default_str();
-  cmd->add_option("--charts", o.charts,
-                  "How the atlas cuts the surface: conformal (charts of many triangles, LSCM) "
-                  "or per-triangle (at least 8 texels a triangle)")
-      ->check(CLI::IsMember(meshes::kAtlasChartsNames.names()))
-      ->capture_default_str();
-  cmd->add_option("--directions", o.directions,
-                  "Direction grid ZxW: azimuth x polar cells over the sphere")
-      ->capture_default_str();
-  add_checked_option(cmd, "--spp", o.spp, "Path-traced samples per texel and direction cell",
-                     integer_in(1, 65536));
+  add_slf_flags(cmd, o.slf, "--samples");
   add_checked_option(cmd, "--bounces", o.bounces, "Interreflections (0: direct light, shadows)",
                      integer_in(0, 16));
   add_checked_option(cmd, "--seed", o.seed, "Seed of the path tracer's random numbers",
@@ -103,16 +85,77 @@ void add_flags(CLI::App* cmd, Options& o) {
   cmd->add_flag("-q,--quiet", o.quiet, "No progress bar");
 }
 
+// Under mpirun: rank r of n bakes rows [r R / n, (r + 1) R / n) into OUT.part<r> (the ranks
+// share the output's file system, as prtr bake's ranks do); after a barrier rank 0 joins the
+// parts (prt::join_slf_parts), compresses, writes OUT and removes them. A row's random numbers
+// are keyed by its index, so the joined matrix is the one-process bake's and the file its
+// bytes. The cache is neither read nor written. A rank that fails ends the whole job before
+// anything appears at OUT.
+pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probes::Probe& probe,
+                         const std::string& probe_name, pipeline::SlfSettings settings,
+                         MpiWorld world) {
+  if (!o.rows.empty()) throw UsageError("--rows and mpirun both split the rows: use one of them");
+  std::uint64_t rows = 0;
+  try {
+    rows = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height).used_texels();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());  // an atlas too small for the mesh
+  }
+  const std::uint64_t ranks = std::uint64_t(world.size);
+  if (rows < ranks || rows < std::uint64_t(std::max(1, settings.compress.clusters)))
+    throw UsageError("mpirun -np " + std::to_string(world.size) + " with --clusters " +
+                     std::to_string(settings.compress.clusters) + ": the atlas has only " +
+                     std::to_string(rows) +
+                     " rows (texels); use fewer ranks or clusters, or a "
+                     "larger --samples atlas");
+  const auto part = [&o](int rank) { return fs::path(o.output + ".part" + std::to_string(rank)); };
+  const bool quiet = o.quiet || o.json || world.rank != 0;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    const MpiCoreShare cores;  // the ranks on one node share its cores while they bake
+    try {
+      prt::SlfBakeOptions bake = settings.bake;
+      bake.first_row = rows * std::uint64_t(world.rank) / ranks;
+      bake.end_row = rows * std::uint64_t(world.rank + 1) / ranks;
+      ProgressBar bar(quiet);
+      bake.progress = [&bar](std::uint64_t done, std::uint64_t total) {
+        bar.update("slf bake (rank 0's rows)", done, total);
+      };
+      const meshes::Atlas atlas =
+          meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height);
+      prt::bake_slf_to_file(mesh, atlas, probe, bake, part(world.rank));
+      bar.finish();
+    } catch (const std::exception& e) {
+      mpi_abort(std::string("slf bake of its rows failed: ") + e.what());
+    }
+  }
+  mpi_barrier();
+  pipeline::SlfRun r;
+  if (world.rank == 0) {
+    try {
+      std::vector<fs::path> parts;
+      for (int rank = 0; rank < world.size; ++rank) parts.push_back(part(rank));
+      prt::SlfMatrix matrix = prt::join_slf_parts(parts);
+      const double bake_seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      r = pipeline::compress_slf(mesh, o.mesh, probe_name, std::move(matrix), settings.compress,
+                                 stderr_reporter(quiet));
+      r.bake_seconds = bake_seconds;
+      pipeline::write_slfc(o.output, r.slf);
+      for (const fs::path& p : parts) fs::remove(p);
+    } catch (const std::exception& e) {
+      mpi_abort(std::string("joining, compressing or writing failed: ") + e.what());
+    }
+  }
+  mpi_barrier();
+  return r;
+}
+
 void run(const Options& o, CLI::App*) {
   check_outputs({{"-o", o.output}}, {{"MESH", o.mesh}, {"--probe", o.probe}});
   pipeline::SlfSettings settings;
-  std::tie(settings.atlas_width, settings.atlas_height) =
-      parse_size(o.samples, "--samples", 4, 8192);
-  settings.charts = meshes::kAtlasChartsNames.parse(o.charts);
-  std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
-      parse_size(o.directions, "--directions", 1, 4096);
+  resolve_slf_flags(o.slf, settings);
   std::tie(settings.bake.first_row, settings.bake.end_row) = parse_rows(o.rows);
-  settings.bake.spp = o.spp;
   settings.bake.bounces = o.bounces;
   settings.bake.seed = o.seed;
   settings.bake.ray_offset = o.ray_offset;
@@ -129,17 +172,24 @@ void run(const Options& o, CLI::App*) {
   }
   const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
   const probes::Probe probe = probes::load_probe(o.probe);
-  const fs::path cache = o.no_cache        ? fs::path()
-                         : o.cache.empty() ? pipeline::default_cache_dir()
-                                           : fs::path(o.cache);
+  const std::string probe_name = fs::path(o.probe).filename().string();
+  const MpiWorld world = mpi_world();
   pipeline::SlfRun r;
-  try {
-    r = pipeline::make_slf(mesh, o.mesh, probe, fs::path(o.probe).filename().string(), settings,
-                           cache, stderr_reporter(o.quiet || o.json));
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());  // an atlas too small for the mesh, too many clusters
+  if (world.size > 1) {
+    r = mpi_slf(o, mesh, probe, probe_name, settings, world);
+    if (world.rank != 0) return;
+  } else {
+    const fs::path cache = o.no_cache        ? fs::path()
+                           : o.cache.empty() ? pipeline::default_cache_dir()
+                                             : fs::path(o.cache);
+    try {
+      r = pipeline::make_slf(mesh, o.mesh, probe, probe_name, settings, cache,
+                             stderr_reporter(o.quiet || o.json));
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());  // an atlas too small for the mesh, too many clusters
+    }
+    pipeline::write_slfc(o.output, r.slf);
   }
-  pipeline::write_slfc(o.output, r.slf);
 
   const std::uint64_t file_bytes = fs::file_size(o.output);
   if (o.json) {

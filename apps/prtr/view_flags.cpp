@@ -3,6 +3,8 @@
 #include "commands.h"
 #include "flag_checks.h"
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <vector>
 
@@ -20,7 +22,10 @@ void add_view_flags(CLI::App* cmd, ViewFlags& f) {
       ->capture_default_str();
   // 2^64 times a radiance of 1e20 is still a float; past it the PNG would be all Inf.
   add_checked_option(cmd, "--exposure", f.exposure, "PNG exposure in stops", number_in(-64, 64));
-  cmd->add_option("--axis", f.axis, "Environment rotation axis x,y,z")->capture_default_str();
+  cmd->add_option("--axis", f.axis,
+                  "Environment rotation axis x,y,z (relight --camera-orbit: the camera's orbit "
+                  "axis, through the mesh's centre)")
+      ->capture_default_str();
 }
 
 Eigen::Vector3d parse_vector(const std::string& text, const char* flag) {
@@ -49,9 +54,25 @@ render::CameraPlacement resolve_placement(const ViewFlags& f) {
   return placement;
 }
 
+Eigen::Vector3d mesh_centre(const meshes::Mesh& mesh) {
+  return meshes::bounds(mesh).center().cast<double>();
+}
+
+render::Camera orbit_camera(const render::Camera& camera, const Eigen::Vector3d& centre,
+                            const Eigen::Vector3d& axis, double radians) {
+  // Unturned exactly: centre + (eye - centre) need not round back to eye.
+  if (radians == 0.0) return camera;
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(radians, axis).toRotationMatrix();
+  render::Camera turned = camera;
+  turned.eye = centre + r * (camera.eye - centre);
+  turned.target = centre + r * (camera.target - centre);
+  turned.up = r * camera.up;
+  return turned;
+}
+
 render::Camera resolve_camera(const ViewFlags& f, const meshes::Mesh& mesh) {
   const render::CameraPlacement placement = resolve_placement(f);
-  const Eigen::Vector3d centre = meshes::bounds(mesh).center().cast<double>();
+  const Eigen::Vector3d centre = mesh_centre(mesh);
   double radius = 0.0;
   for (const auto& p : mesh.positions)
     radius = std::max(radius, (p.cast<double>() - centre).norm());

@@ -29,7 +29,15 @@ render::CameraPlacement resolve_placement(const ViewFlags& flags);
 // The default camera frames the mesh's bounding sphere; --eye/--target/--up override it.
 render::Camera resolve_camera(const ViewFlags& flags, const meshes::Mesh& mesh);
 render::Background resolve_background(const ViewFlags& flags);
-// The unit environment-rotation axis.
+// The unit environment-rotation axis (relight --camera-orbit: the camera's orbit axis).
 Eigen::Vector3d resolve_axis(const ViewFlags& flags);
+
+// The point the default camera looks at: the centre of the mesh's bounding box.
+Eigen::Vector3d mesh_centre(const meshes::Mesh& mesh);
+// `camera` turned by `radians` about the unit `axis` through `centre` (right-handed:
+// counter-clockwise seen from the axis's tip): eye, target and up turn together, so the
+// view of the mesh turns and nothing else about the camera changes.
+render::Camera orbit_camera(const render::Camera& camera, const Eigen::Vector3d& centre,
+                            const Eigen::Vector3d& axis, double radians);
 
 }  // namespace prtr_app

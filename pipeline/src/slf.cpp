@@ -119,17 +119,33 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
       matrix = prt::read_slf(run.bake_path);
     }
   }
-  run.bake_seconds = seconds_since(bake_start);
+  const double bake_seconds = seconds_since(bake_start);
+  SlfRun compressed =
+      compress_slf(mesh, mesh_path, probe_name, std::move(matrix), settings.compress, reporter);
+  compressed.bake_seconds = bake_seconds;
+  compressed.bake_cached = run.bake_cached;
+  compressed.bake_path = run.bake_path;
+  return compressed;
+}
 
-  settings.compress.layout = {1, 3, settings.bake.grid.directions()};
+SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
+                    const std::string& probe_name, prt::SlfMatrix matrix,
+                    cpca::CompressOptions compress, const Reporter& reporter) {
+  SlfRun run;
+  const std::uint64_t count = matrix.shape.row_count;
+  const std::size_t columns = matrix.shape.columns();
+  if (matrix.data.size() != count * columns)
+    throw std::invalid_argument("compress_slf: the matrix holds " +
+                                std::to_string(matrix.data.size()) + " floats, not " +
+                                std::to_string(count) + " rows x " + std::to_string(columns));
+  compress.layout = {1, 3, matrix.shape.grid.directions()};
   const Eigen::Map<const cpca::DataMatrix> data(matrix.data.data(), Eigen::Index(count),
                                                 Eigen::Index(columns));
   const auto compress_start = std::chrono::steady_clock::now();
-  cpca::CompressedSet set =
-      cpca::compress(data, settings.compress, nullptr, &run.report,
-                     [&reporter](const std::string& stage, double fraction) {
-                       reporter.report(stage, std::uint64_t(std::lround(1000 * fraction)), 1000);
-                     });
+  cpca::CompressedSet set = cpca::compress(
+      data, compress, nullptr, &run.report, [&reporter](const std::string& stage, double fraction) {
+        reporter.report(stage, std::uint64_t(std::lround(1000 * fraction)), 1000);
+      });
   reporter.end_step();
   run.compress_seconds = seconds_since(compress_start);
   set.mesh_hash = meshes::content_hash(mesh);

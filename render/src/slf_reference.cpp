@@ -74,7 +74,7 @@ Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
             double(u[j]) * slf_reference_taps::view_lookup(model, cluster, 1 + j, taps);
       sum += weight * texel_radiance;
     }
-  return sum.cast<float>();
+  return sum.cwiseMax(0.0).cast<float>();  // after the blend: render/slf_reference.h
 }
 
 Image render_slf_reference(const SlfModel& model, const Camera& camera,

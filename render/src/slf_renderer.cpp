@@ -220,8 +220,9 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
     s += "xyz"[channel];
     s += " += " + coefficient + " * t" + std::to_string(f / 4) + "." + "xyzw"[f % 4] + ";\n";
   }
+  // Negative radiance clamped after the spatial blend, as render/slf_reference.h explains.
   s += "  } while (any(greaterThan(left, vec4(0.0))));\n"
-       "  o_colour = vec4(l, 1.0);\n"
+       "  o_colour = vec4(max(l, vec3(0.0)), 1.0);\n"
        "}\n";
   return s;
 }

@@ -51,4 +51,12 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
                 const std::string& probe_name, SlfSettings settings,
                 const std::filesystem::path& cache_dir, const Reporter& reporter);
 
+// The compression half of make_slf: CPCA of a baked matrix (its shape says which rows) and
+// the figures, for a matrix baked elsewhere (prtr slf under mpirun joins the ranks' parts).
+// The bake fields of the result are left at zero. Throws std::invalid_argument for bad
+// options (more clusters than rows) and a matrix whose data does not match its shape.
+SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
+                    const std::string& probe_name, prt::SlfMatrix matrix,
+                    cpca::CompressOptions compress, const Reporter& reporter);
+
 }  // namespace pipeline

@@ -17,6 +17,14 @@
 //    gives in one fetch, so the GL path and this reference compute the same function.
 //  - Every texel uses the fragment's own direction; the paper recomputes it from each of the
 //    four texels' surface points, which differ by less than a texel and are not in the model.
+//  - Negative radiance is clamped to 0 per channel once, after the spatial blend: CPCA's
+//    reconstruction of a noisy matrix undershoots where the data is near zero (a silhouette
+//    whose red and green go below zero shows as blue dots). Clamping each texel before the
+//    blend would suit the data slightly better (a negative texel would no longer darken its
+//    neighbours), but the GL path's shared-cluster fast path reconstructs the four texels of
+//    one cluster as one interpolated weight vector (the same sum by linearity only), so a
+//    per-texel clamp would cost it its single reconstruction; after the blend both paths
+//    clamp the same function at the same point.
 // Texels with cluster -1 (no triangle reads them; the atlas never puts one under a lookup
 // inside a triangle) and texels of zero weight contribute nothing and are not read.
 #pragma once

@@ -1,0 +1,53 @@
+#include "slf_flags.h"
+
+#include "commands.h"
+#include "flag_checks.h"
+
+#include <cstdio>
+#include <utility>
+
+namespace prtr_app {
+namespace {
+
+// "AxB" with both in [lo, hi]; UsageError naming the flag otherwise.
+std::pair<int, int> parse_size(const std::string& text, const char* flag, int lo, int hi) {
+  int a = 0, b = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &a, &x, &b, &extra) != 3 || (x != 'x' && x != 'X') ||
+      a < lo || a > hi || b < lo || b > hi) {
+    throw UsageError(std::string(flag) + " " + text + ": expected WxH with both in [" +
+                     std::to_string(lo) + ", " + std::to_string(hi) + "] (e.g. 256x256)");
+  }
+  return {a, b};
+}
+
+}  // namespace
+
+void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
+  f.samples_flag = samples_flag;
+  cmd->add_option(samples_flag, f.samples,
+                  "Surface light field: atlas size WxH in texels, the surface samples")
+      ->capture_default_str();
+  cmd->add_option("--charts", f.charts,
+                  "Surface light field: how the atlas cuts the surface: conformal (charts of many "
+                  "triangles, LSCM) or per-triangle (at least 8 texels a triangle)")
+      ->check(CLI::IsMember(meshes::kAtlasChartsNames.names()))
+      ->capture_default_str();
+  cmd->add_option("--directions", f.directions,
+                  "Surface light field: direction grid ZxW, azimuth x polar cells over the sphere")
+      ->capture_default_str();
+  add_checked_option(cmd, "--spp", f.spp,
+                     "Surface light field: path-traced samples per texel and direction cell",
+                     integer_in(1, 65536));
+}
+
+void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
+  std::tie(settings.atlas_width, settings.atlas_height) =
+      parse_size(f.samples, f.samples_flag, 4, 8192);
+  settings.charts = meshes::kAtlasChartsNames.parse(f.charts);
+  std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
+      parse_size(f.directions, "--directions", 1, 4096);
+  settings.bake.spp = f.spp;
+}
+
+}  // namespace prtr_app

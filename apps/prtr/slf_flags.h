@@ -1,0 +1,29 @@
+// apps/prtr/slf_flags.h: the surface light field's sampling flags (the atlas size, --charts,
+// --directions, --spp), registered with one help text and one set of defaults by the commands that
+// make an SLF: prtr slf (atlas size as --samples) and prtr relight --kind slf (as --slf-samples,
+// since its --samples is the PRT bake's directions per vertex).
+#pragma once
+
+#include "meshes/atlas.h"
+#include "pipeline/slf.h"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace prtr_app {
+
+struct SlfFlags {
+  std::string samples = "256x256", directions = "32x16",
+              charts = std::string(meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal));
+  int spp = 16;
+  const char* samples_flag = "--samples";  // the atlas size's flag name, for messages
+};
+
+void add_slf_flags(CLI::App* command, SlfFlags& flags, const char* samples_flag);
+
+// The atlas size and charts, direction grid and spp into `settings`; UsageError naming a malformed
+// flag.
+void resolve_slf_flags(const SlfFlags& flags, pipeline::SlfSettings& settings);
+
+}  // namespace prtr_app
