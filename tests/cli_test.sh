@@ -536,6 +536,21 @@ if [[ -f $forest ]]; then
   expect_code 2 && [[ $err == *--mode* ]]; check "relight --kind slf: a PRT flag is a usage error naming it" $?
   run relight "$tmp/cube.obj" --probe "$forest" --spp 4 --out "$tmp/x"
   expect_code 2 && [[ $err == *--spp* ]]; check "relight: an SLF flag without --kind slf is a usage error naming it" $?
+  # prtr view serves a .slfc too (tests/view_slf_browser_test.py opens one); another probe and
+  # PRT's flags are refused before it listens (the timeout stops one that serves instead).
+  view_slf() {
+    out=$(timeout 60 "$prtr" view "$tmp/cube.slfc" --port 0 -q "$@" 2>"$tmp/err"); code=$?; err=$(cat "$tmp/err")
+  }
+  view_slf --probe "${forest%forest.exr}city.exr"
+  expect_code 2 && [[ $err == *--probe* && $err == *forest.exr* ]]; check "view: a .slfc under another probe is a usage error naming the baked one" $?
+  for flag in "--mode cpu" "--strategy order" "--register-budget 64" "--clusters 8" "--order 4" "--axis 1,0,0" "--cache $tmp"; do
+    view_slf --probe "$forest" $flag
+    expect_code 2 && [[ $err == *"${flag%% *} applies to meshes"* && $err == *"surface light field"* ]]; check "view: ${flag%% *} with a .slfc is a usage error naming it" $?
+  done
+  view_slf --probe "$forest" --mesh "$tmp/missing.obj"
+  expect_code 1 && [[ $err == *missing.obj* ]]; check "view: a .slfc's --mesh is the mesh it loads" $?
+  run view "$tmp/cube.obj" --probe "$forest" --mesh "$tmp/cube.obj"
+  expect_code 2 && [[ $err == *--mesh* ]]; check "view: --mesh beside a mesh is a usage error" $?
   # prtr compare: an image against itself is exact; against the path-traced one it is not.
   run compare "$tmp/slf.exr" "$tmp/slf.exr" --json
   expect_code 0 && [[ $out == *'"relative_rmse":0'* ]]; check "compare: an image against itself has no error" $?

@@ -1,6 +1,8 @@
 // prtr view MESH --probe PROBE: interactive relighting in a browser. Bakes and compresses
-// through the cache as relight does, then serves a page (view_page.h) that asks for frames
-// rendered on demand by one OSMesa renderer (view_scene.h, view_server.h).
+// through the cache as relight does, then serves a page (viewer/src/page.cpp) that asks for
+// frames rendered on demand by one OSMesa renderer (viewer/scene.h, viewer/server.h).
+// prtr view X.slfc --probe PROBE serves a surface light field the same way
+// (viewer/slf_scene.h): its lighting is baked, so the page orbits the camera only.
 #include "bake_flags.h"
 #include "commands.h"
 #include "compress_flags.h"
@@ -8,21 +10,25 @@
 #include "cpca/supercluster_strategy.h"
 #include "flag_checks.h"
 #include "gl_flags.h"
+#include "mesh_flags.h"
 #include "meshes/load.h"
 #include "pipeline/pipeline.h"
 #include "probes/load.h"
 #include "progress_bar.h"
 #include "prt/sh.h"
+#include "slf_input.h"
 #include "supersample_flag.h"
 #include "view_flags.h"
 #include "viewer/scene.h"
 #include "viewer/server.h"
+#include "viewer/slf_scene.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -38,6 +44,8 @@ using viewer::ViewState;
 
 struct Options {
   std::string mesh, probe, cache, mode = "decoupled", strategy = "greedy-refine";
+  std::string slf_mesh;  // --mesh, for a .slfc only
+  MeshFlags mesh_flags;
   BakeFlags bake;
   CompressFlags compress;
   ViewFlags view;
@@ -49,10 +57,17 @@ struct Options {
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
-  cmd->add_option("MESH", o.mesh, std::string("Mesh file: ") + meshes::kMeshFormats)->required();
-  cmd->add_option("--probe", o.probe,
-                  "Light probe (EXR/HDR); the page offers every *.exr/*.hdr in its folder")
+  cmd->add_option("MESH", o.mesh,
+                  std::string("Mesh file (") + meshes::kMeshFormats +
+                      "), or a surface light field (.slfc) from prtr slf")
       ->required();
+  cmd->add_option("--probe", o.probe,
+                  "Light probe (EXR/HDR); the page offers every *.exr/*.hdr in its folder (a "
+                  ".slfc: the probe it was baked under, and only that one)")
+      ->required();
+  cmd->add_option("--mesh", o.slf_mesh,
+                  "A .slfc's mesh (default: the path it records); MESH is the mesh otherwise");
+  add_mesh_flags(cmd, o.mesh_flags);
   add_checked_option(
       cmd, "--mode", o.mode, "Initial rendering path",
       CLI::IsMember({"multipass", "singlepass", "decoupled", "cpu", "uncompressed"}));
@@ -107,7 +122,8 @@ Json info_json(const Options& o, const meshes::Mesh& mesh, const cpca::Compresse
   Json strategies = Json::array();
   for (const auto& s : cpca::supercluster_strategies()) strategies.push_back(std::string(s.name));
   const ViewState& d = served.defaults;
-  return Json{{"mesh", fs::path(o.mesh).filename().string()},
+  return Json{{"kind", "prt"},
+              {"mesh", fs::path(o.mesh).filename().string()},
               {"vertices", mesh.vertex_count()},
               {"triangles", mesh.triangle_count()},
               {"clusters", set.cluster_count},
@@ -154,7 +170,83 @@ ViewState initial_state(const Options& o, int probe) {
   return s;
 }
 
-void run(const Options& o, CLI::App*) {
+// The flags a surface light field reads: its input, the camera and image, the GL backend and
+// the server. Every other one (bake, compression, rendering path, environment axis, cache)
+// describes PRT work that a .slfc has already had done, once, under its own settings.
+const std::set<std::string>& slf_flags() {
+  static const std::set<std::string> flags = {
+      "MESH",        "--probe", "--mesh", "--crease-angle", "--width",    "--height",      "--eye",
+      "--target",    "--up",    "--fov",  "--background",   "--exposure", "--supersample", "--gl",
+      "--gl-device", "--host",  "--port", "--quiet",        "--help"};
+  return flags;
+}
+
+Json slf_info_json(const Options& o, const SlfInput& in, const SceneInfo& scene,
+                   const ViewState& d) {
+  const pipeline::CompressedSlf& slf = in.slf;
+  return Json{{"kind", "slf"},
+              {"slfc", fs::path(o.mesh).filename().string()},
+              {"mesh", fs::path(in.mesh_path).filename().string()},
+              {"vertices", in.mesh.vertex_count()},
+              {"triangles", in.mesh.triangle_count()},
+              {"clusters", slf.set.cluster_count},
+              {"components", slf.set.component_count},
+              {"texels", slf.bake.rows},
+              {"atlas_width", slf.bake.atlas_width},
+              {"atlas_height", slf.bake.atlas_height},
+              {"directions", slf.bake.grid.directions()},
+              {"azimuth", slf.bake.grid.azimuth},
+              {"elevation", slf.bake.grid.elevation},
+              {"probe_name", slf.probe_name},
+              {"probes", Json::array({fs::path(o.probe).filename().string()})},
+              {"gl_renderer", scene.gl_renderer},
+              {"gl_version", scene.gl_version},
+              {"llvmpipe_threads", scene.llvmpipe_threads},
+              {"llvmpipe_threads_source", scene.llvmpipe_threads_source},
+              {"still_samples", o.supersample},
+              {"defaults",
+               {{"probe", 0}, {"exposure", d.exposure}, {"width", d.width}, {"height", d.height}}}};
+}
+
+// prtr view X.slfc: the light field under the probe it was baked under, the camera orbiting.
+void run_slf(const Options& o, CLI::App* cmd) {
+  for (const CLI::Option* option : cmd->get_options()) {
+    const std::string name = option->get_name();
+    if (option->count() > 0 && slf_flags().count(name) == 0)
+      throw UsageError(name + " applies to meshes (PRT); " + o.mesh +
+                       " is a surface light field, whose lighting and compression are baked "
+                       "and which renders in one pass");
+  }
+  const render::Background background = resolve_background(o.view);
+  const render::CameraPlacement placement = resolve_placement(o.view);
+  const render::GlSelection gl = gl_selection(o.gl);
+  const SlfInput in = load_slf_input(o.mesh, o.slf_mesh, o.mesh_flags, o.probe);
+  resolve_camera(o.view, in.mesh);  // a bad --eye or --fov: exit 2 now
+  const std::string name = fs::path(o.mesh).filename().string();
+  viewer::SlfScene scene({&in.mesh, &in.model, &in.probe, name, placement, background, gl});
+  ServedInfo served;
+  served.defaults.width = o.view.width;
+  served.defaults.height = o.view.height;
+  served.defaults.exposure = o.view.exposure;
+  served.limits.probe_count = 1;
+  served.limits.cluster_count = in.slf.set.cluster_count;
+  const auto first = scene.render(served.defaults);
+  if (!first->request_error.empty()) throw UsageError(first->request_error);
+  if (!first->server_error.empty()) throw std::runtime_error(first->server_error);
+  served.info = slf_info_json(o, in, scene.info(), served.defaults);
+  std::printf(
+      "prtr view: %s, surface light field of %d cluster(s) x %d term(s), %llu texels, %d x %d "
+      "directions; first frame %.0f ms\n",
+      o.mesh.c_str(), int(in.slf.set.cluster_count), int(in.slf.set.component_count),
+      static_cast<unsigned long long>(in.slf.bake.rows), in.slf.bake.grid.azimuth,
+      in.slf.bake.grid.elevation, first->stats.render_ms);
+  viewer::serve_view(scene, served, o.server);
+}
+
+void run(const Options& o, CLI::App* cmd) {
+  if (is_slfc(o.mesh)) return run_slf(o, cmd);
+  if (!o.slf_mesh.empty())
+    throw UsageError("--mesh names a .slfc's mesh; " + o.mesh + " is the mesh here");
   const prt::BakeOptions bake = resolve_bake_flags(o.bake);
   const cpca::CompressOptions compress = resolve_compress_flags(o.compress);
   const render::Background background = resolve_background(o.view);
@@ -165,7 +257,7 @@ void run(const Options& o, CLI::App*) {
   const std::vector<fs::path> probes = scan_probes(o.probe, probe_index);
   ServedInfo served;
   served.defaults = initial_state(o, probe_index);
-  const meshes::Mesh mesh = meshes::load_mesh(o.mesh);
+  const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
   resolve_camera(o.view, mesh);
   probes::load_probe(o.probe);  // fail before the long work
   const fs::path cache = o.cache.empty() ? pipeline::default_cache_dir() : fs::path(o.cache);
@@ -223,7 +315,7 @@ void run(const Options& o, CLI::App*) {
 
 constexpr const char* kAbout =
     "Bake, compress (cached) and serve MESH under PROBE to a browser: drag to relight, with "
-    "render modes, probes, overlays and live statistics";
+    "render modes, probes, overlays and live statistics; or orbit a surface light field (.slfc)";
 
 }  // namespace cmd_view
 

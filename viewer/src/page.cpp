@@ -3,9 +3,12 @@
 namespace viewer {
 
 // Drag rotates the environment (shift-drag, or the "camera" drag mode, orbits the camera),
-// the wheel zooms. One request at a time: input while a frame is on its way only marks the
-// view dirty, and the next request carries the newest state (the server coalesces too).
-// Latency per frame = queue + render + overlay + encode (the server's X-Prtr-Frame header)
+// the wheel zooms. A surface light field (/api/info's kind "slf") has its lighting baked: the
+// page hides what only PRT can change (environment, probe, modes, overlays, compressions),
+// drag and the arrow keys orbit the camera, and requests carry only what it can show. One request
+// at a time: input while a frame is on its way only marks the view dirty, and the next request
+// carries the newest state (the server coalesces too). Latency per frame = queue + render + overlay
+// + encode (the server's X-Prtr-Frame header)
 // + transfer (the rest of the time from sending the request to the decoded image).
 const char* view_page_html() {
   return R"PAGE(<!DOCTYPE html>
@@ -22,19 +25,26 @@ table { border-collapse: collapse; }
 td { padding: 1px 6px 1px 0; vertical-align: top; }
 td:first-child { color: #999; }
 #stat-error, .refused { color: #f77; }
+.slf-only, body.slf .prt-only { display: none; }
+body.slf .slf-only { display: revert; }
+#about { margin: 0 0 8px 0; }
 </style></head>
 <body>
 <div id="view"><img id="frame" alt="relit mesh" draggable="false"></div>
 <div id="panel">
+<fieldset class="slf-only"><legend>About</legend><div id="about"></div></fieldset>
 <fieldset><legend>Interaction</legend>
-<label><input type="radio" name="drag" value="env" id="drag-env" checked> drag rotates the environment</label>
-<label><input type="radio" name="drag" value="cam" id="drag-cam"> drag orbits the camera</label>
-<div>shift-drag does the other; the wheel zooms. <button id="reset">reset view</button></div>
-<label><input type="checkbox" id="autorotate"> auto-rotate the environment</label>
-<div>keys: arrows turn the environment (shift: orbit the camera), + and - zoom, space
+<label class="prt-only"><input type="radio" name="drag" value="env" id="drag-env" checked> drag rotates the environment</label>
+<label class="prt-only"><input type="radio" name="drag" value="cam" id="drag-cam"> drag orbits the camera</label>
+<div><span class="prt-only">shift-drag does the other;</span><span class="slf-only">drag orbits
+the camera (the lighting is baked);</span> the wheel zooms. <button id="reset">reset view</button></div>
+<label class="prt-only"><input type="checkbox" id="autorotate"> auto-rotate the environment</label>
+<div class="prt-only">keys: arrows turn the environment (shift: orbit the camera), + and - zoom, space
 auto-rotates, r resets</div>
+<div class="slf-only">keys: arrows orbit the camera, + and - zoom, r resets</div>
 </fieldset>
 <fieldset><legend>Rendering</legend>
+<div class="prt-only">
 <label>mode <select id="mode"></select></label>
 <label>super-clusters <select id="strategy"></select></label>
 <label>register budget <input id="budget" type="number" min="0" step="1" value="0"> (0: the context's)</label>
@@ -44,15 +54,17 @@ auto-rotates, r resets</div>
 <label>clusters <input id="clusters" type="number" min="1" step="1"> PCs <input id="pcs" type="number" min="1" step="1"> SH order <input id="order" type="number" min="1" step="1"></label>
 <div class="refused" id="refused-clusters"></div><div class="refused" id="refused-pcs"></div><div class="refused" id="refused-order"></div>
 <div id="compress-status"></div>
+</div>
 <label>size <select id="size"></select></label>
 <label><input type="checkbox" id="antialias" checked> anti-alias the still image (<span id="antialias-samples">2 × 2</span> samples once the view stops)</label>
 <div class="refused" id="refused-size"></div>
 </fieldset>
 <fieldset><legend>Lighting</legend>
-<label>probe <select id="probe"></select></label>
+<label class="prt-only">probe <select id="probe"></select></label>
+<div class="slf-only">probe <span id="slf-probe"></span> (baked into the light field)</div>
 <label>exposure <input id="exposure" type="range" min="-6" max="6" step="0.25" value="0"> <span id="exposure-value">0</span></label>
 </fieldset>
-<fieldset><legend>Overlays</legend>
+<fieldset class="prt-only" id="overlays"><legend>Overlays</legend>
 <label><input type="checkbox" id="overlay-overdraw"> overdraw (passes per triangle)</label>
 <label><input type="checkbox" id="overlay-clusters"> clusters</label>
 <label><input type="checkbox" id="overlay-difference"> difference from the uncompressed transfer (red: 10 % or more)</label>
@@ -61,19 +73,19 @@ auto-rotates, r resets</div>
 <tr><td>render FPS</td><td id="stat-render-fps">-</td></tr>
 <tr><td>end-to-end FPS</td><td id="stat-e2e-fps">-</td></tr>
 <tr><td>latency (ms)</td><td id="stat-latency">-</td></tr>
-<tr><td>environment</td><td id="stat-env">-</td></tr>
+<tr class="prt-only"><td>environment</td><td id="stat-env">-</td></tr>
 <tr><td>camera</td><td id="stat-cam">-</td></tr>
-<tr><td>mode</td><td id="stat-mode">-</td></tr>
+<tr class="prt-only"><td>mode</td><td id="stat-mode">-</td></tr>
 <tr><td>samples per pixel</td><td id="stat-aa">-</td></tr>
-<tr><td>passes</td><td id="stat-passes">-</td></tr>
-<tr><td>average overdraw</td><td id="stat-overdraw">-</td></tr>
-<tr><td>clusters per pass</td><td id="stat-cpp">-</td></tr>
-<tr><td>register budget</td><td id="stat-budget">-</td></tr>
+<tr class="prt-only"><td>passes</td><td id="stat-passes">-</td></tr>
+<tr class="prt-only"><td>average overdraw</td><td id="stat-overdraw">-</td></tr>
+<tr class="prt-only"><td>clusters per pass</td><td id="stat-cpp">-</td></tr>
+<tr class="prt-only"><td>register budget</td><td id="stat-budget">-</td></tr>
 <tr><td>clusters</td><td id="stat-clusters">-</td></tr>
-<tr><td>PCs</td><td id="stat-pcs">-</td></tr>
-<tr><td>order</td><td id="stat-order">-</td></tr>
-<tr><td>Average SE</td><td id="stat-se">-</td></tr>
-<tr><td>difference</td><td id="stat-difference">-</td></tr>
+<tr><td><span class="prt-only">PCs</span><span class="slf-only">PCA terms (k)</span></td><td id="stat-pcs">-</td></tr>
+<tr class="prt-only"><td>order</td><td id="stat-order">-</td></tr>
+<tr class="prt-only"><td>Average SE</td><td id="stat-se">-</td></tr>
+<tr class="prt-only"><td>difference</td><td id="stat-difference">-</td></tr>
 <tr><td>mesh</td><td id="stat-mesh">-</td></tr>
 <tr><td>renderer</td><td id="stat-gl">-</td></tr>
 <tr><td>llvmpipe threads</td><td id="stat-threads">-</td></tr>
@@ -90,6 +102,9 @@ const state = { w: 960, h: 710, env_yaw: 0, env_pitch: 0, cam_yaw: 0, cam_pitch:
   mode: "decoupled", strategy: "greedy-refine", budget: 0, cpp: 0, probe: 0, exposure: 0,
   overlay: "none", aa: 1, clusters: 0, pcs: 0, order: 0 };
 let seq = 0, inflight = false, dirty = true, shown = 0, objectUrl = null;
+let slf = false;         // a surface light field: the camera is all that moves
+// What a surface light field's request carries: the rest is PRT's (the server refuses it).
+const slfKeys = ["w", "h", "cam_yaw", "cam_pitch", "zoom", "exposure", "aa"];
 let good = null;         // the last state that rendered: a refused setting falls back to it
 let stillSamples = 2;    // prtr view --supersample: samples per pixel of a still view
 // Which control sets a query parameter, so that a refusal is shown beside it.
@@ -109,7 +124,8 @@ function changed() { state.aa = 1; dirty = true; pump(); }
 
 function query() {
   const q = new URLSearchParams({ client: client, seq: String(++seq) });
-  for (const [k, v] of Object.entries(state)) q.set(k, String(v));
+  for (const [k, v] of Object.entries(state))
+    if (!slf || slfKeys.includes(k)) q.set(k, String(v));
   return q.toString();
 }
 
@@ -233,7 +249,7 @@ function showStats(f, total, server) {
 let drag = null;
 $("frame").addEventListener("mousedown", (e) => {
   e.preventDefault();
-  const camera = $("drag-cam").checked !== e.shiftKey;
+  const camera = slf || $("drag-cam").checked !== e.shiftKey;
   drag = { x: e.clientX, y: e.clientY, camera: camera };
 });
 window.addEventListener("mousemove", (e) => {
@@ -258,7 +274,7 @@ let lastTick = performance.now();
 function tick(now) {
   const dt = Math.min(0.1, Math.max(0, now - lastTick) / 1000);
   lastTick = now;
-  if ($("autorotate").checked && !drag) {
+  if ($("autorotate").checked && !drag && !slf) {
     state.env_yaw = wrap(state.env_yaw + 30 * dt);
     changed();
   }
@@ -270,18 +286,19 @@ window.addEventListener("keydown", (e) => {
   const tag = e.target && e.target.tagName;
   if (tag === "INPUT" || tag === "SELECT" || tag === "BUTTON") return;
   const step = e.key === "ArrowLeft" || e.key === "ArrowUp" ? -5 : 5;
+  const camera = e.shiftKey || slf;
   switch (e.key) {
     case "ArrowLeft": case "ArrowRight":
-      if (e.shiftKey) state.cam_yaw = wrap(state.cam_yaw - step);
+      if (camera) state.cam_yaw = wrap(state.cam_yaw - step);
       else state.env_yaw = wrap(state.env_yaw + step);
       break;
     case "ArrowUp": case "ArrowDown":
-      if (e.shiftKey) state.cam_pitch = clamp(state.cam_pitch + step, -89, 89);
+      if (camera) state.cam_pitch = clamp(state.cam_pitch + step, -89, 89);
       else state.env_pitch = wrap(state.env_pitch + step);
       break;
     case "+": case "=": state.zoom = clamp(Math.round(state.zoom * 1100) / 1000, 0.1, 20); break;
     case "-": case "_": state.zoom = clamp(Math.round(state.zoom / 1.1 * 1000) / 1000, 0.1, 20); break;
-    case " ": $("autorotate").checked = !$("autorotate").checked; break;  // changed() below
+    case " ": if (slf) return; $("autorotate").checked = !$("autorotate").checked; break;  // changed() below
     case "r": $("reset").click(); break;
     default: return;
   }
@@ -360,26 +377,31 @@ function fill(id, values, selected) {
   });
 }
 
-async function start() {
-  const info = await (await fetch("/api/info")).json();
+// A surface light field: the PRT controls are hidden and disabled, dragging orbits the
+// camera, and the about box says what was baked.
+function startSlf(info) {
+  slf = true;
+  document.body.classList.add("slf");
+  $("drag-cam").checked = true;
+  $("autorotate").checked = false;
+  for (const id of ["drag-env", "autorotate", "mode", "strategy", "budget", "cpp", "clusters", "pcs",
+                    "order", "probe", "overlay-overdraw", "overlay-clusters", "overlay-difference"])
+    $(id).disabled = true;
+  $("about").textContent = "surface light field " + info.slfc + " of " + info.mesh + ": k = " +
+      info.components + " PCA terms, " + info.clusters + " clusters, " + info.texels +
+      " texels (" + info.atlas_width + " × " + info.atlas_height + " atlas), " +
+      info.directions + " directions (" + info.azimuth + " × " + info.elevation + ")";
+  $("slf-probe").textContent = info.probe_name;
+  $("stat-clusters").textContent = String(info.clusters);
+  $("stat-pcs").textContent = String(info.components);
+}
+
+function startPrt(info) {
   state.mode = info.defaults.mode; state.strategy = info.defaults.strategy;
-  state.probe = info.defaults.probe; state.exposure = info.defaults.exposure;
-  state.w = info.defaults.width; state.h = info.defaults.height;
-  stillSamples = info.still_samples;
-  if (stillSamples < 2) { $("antialias").checked = false; $("antialias").disabled = true; }
-  $("antialias-samples").textContent = stillSamples + " × " + stillSamples;
-  if (urlParams.has("w")) state.w = Number(urlParams.get("w"));
-  if (urlParams.has("h")) state.h = Number(urlParams.get("h"));
   if (urlParams.has("mode")) state.mode = urlParams.get("mode");
   fill("mode", info.modes, state.mode);
   fill("strategy", info.strategies, state.strategy);
   fill("probe", info.probes.map((p, i) => [String(i), p]), state.probe);
-  const s = [["window", "fit the window"]].concat(sizes.map(([w, h]) => [w + "x" + h, w + " × " + h]));
-  if (!sizes.some(([w, h]) => w === state.w && h === state.h))
-    s.unshift([state.w + "x" + state.h, state.w + " × " + state.h]);
-  fill("size", s, state.w + "x" + state.h);
-  $("exposure").value = String(state.exposure);
-  $("exposure-value").textContent = state.exposure.toFixed(2);
   $("stat-clusters").textContent = String(info.clusters);
   $("stat-pcs").textContent = String(info.pcs);
   launch = { clusters: info.clusters, pcs: info.pcs, order: info.order,
@@ -391,6 +413,25 @@ async function start() {
   $("order").max = String(info.max_order);
   $("stat-order").textContent = String(info.order);
   $("stat-se").textContent = info.average_se.toPrecision(4);
+}
+
+async function start() {
+  const info = await (await fetch("/api/info")).json();
+  state.probe = info.defaults.probe; state.exposure = info.defaults.exposure;
+  state.w = info.defaults.width; state.h = info.defaults.height;
+  stillSamples = info.still_samples;
+  if (stillSamples < 2) { $("antialias").checked = false; $("antialias").disabled = true; }
+  $("antialias-samples").textContent = stillSamples + " × " + stillSamples;
+  if (urlParams.has("w")) state.w = Number(urlParams.get("w"));
+  if (urlParams.has("h")) state.h = Number(urlParams.get("h"));
+  if (info.kind === "slf") startSlf(info);
+  else startPrt(info);
+  const s = [["window", "fit the window"]].concat(sizes.map(([w, h]) => [w + "x" + h, w + " × " + h]));
+  if (!sizes.some(([w, h]) => w === state.w && h === state.h))
+    s.unshift([state.w + "x" + state.h, state.w + " × " + state.h]);
+  fill("size", s, state.w + "x" + state.h);
+  $("exposure").value = String(state.exposure);
+  $("exposure-value").textContent = state.exposure.toFixed(2);
   $("stat-mesh").textContent = info.mesh + " (" + info.vertices + " vertices)";
   $("stat-gl").textContent = info.gl_renderer;
   $("stat-threads").textContent = info.llvmpipe_threads + " (" + info.llvmpipe_threads_source + ")";

@@ -247,15 +247,21 @@ ViewScene::ViewScene(SceneInputs inputs) : impl_(std::make_unique<Impl>(std::mov
   Impl& m = *impl_;
   m.axis = m.inputs.axis;
   const render::GlInfo gl = m.context.info();
-  m.info.gl_renderer = gl.renderer;
-  m.info.gl_version = gl.version;
+  m.info = context_scene_info(gl);
   m.info.default_register_budget = gl.default_register_budget();
   m.info.registers_per_cluster =
       render::constant_layout(m.inputs.compressions->launch()).registers_per_cluster();
+}
+
+SceneInfo context_scene_info(const render::GlInfo& gl) {
+  SceneInfo info;
+  info.gl_renderer = gl.renderer;
+  info.gl_version = gl.version;
   // llvmpipe's rasteriser threads: LP_NUM_THREADS when set, else one per CPU.
   const char* lp = std::getenv("LP_NUM_THREADS");
-  m.info.llvmpipe_threads = lp ? std::atoi(lp) : int(std::thread::hardware_concurrency());
-  m.info.llvmpipe_threads_source = lp ? "LP_NUM_THREADS" : "CPUs";
+  info.llvmpipe_threads = lp ? std::atoi(lp) : int(std::thread::hardware_concurrency());
+  info.llvmpipe_threads_source = lp ? "LP_NUM_THREADS" : "CPUs";
+  return info;
 }
 
 ViewScene::~ViewScene() = default;

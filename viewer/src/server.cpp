@@ -167,7 +167,7 @@ class Routes {
 };
 
 // The render loop: one job at a time until the queue stops.
-void render_jobs(ViewScene& scene, FrameQueue& queue) {
+void render_jobs(FrameSource& scene, FrameQueue& queue) {
   while (std::optional<FrameQueue::Job> job = queue.take()) {
     const double queued = elapsed_ms(job->submitted);
     std::shared_ptr<RenderedFrame> frame = scene.render(job->state);
@@ -219,7 +219,7 @@ Json frame_header(const RenderedFrame& f) {
               {"compress_error", t.compress_error}};
 }
 
-void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions& options) {
+void serve_view(FrameSource& scene, const ServedInfo& served, const ServerOptions& options) {
   FrameQueue queue;
   Routes routes(queue, served, options);
   detail::HttpServerOptions http;

@@ -11,6 +11,7 @@
 #include "render/renderer.h"
 #include "viewer/compressions.h"
 #include "viewer/frame.h"
+#include "viewer/frame_source.h"
 #include "viewer/request.h"
 
 #include <filesystem>
@@ -40,16 +41,18 @@ struct SceneInfo {
   int default_register_budget = 0, registers_per_cluster = 0;
 };
 
-class ViewScene {
+// The GL context's half of SceneInfo (renderer, version, llvmpipe threads); both scenes show it.
+SceneInfo context_scene_info(const render::GlInfo& gl);
+
+class ViewScene : public FrameSource {
  public:
   explicit ViewScene(SceneInputs inputs);
-  ~ViewScene();
+  ~ViewScene() override;
   ViewScene(const ViewScene&) = delete;
   ViewScene& operator=(const ViewScene&) = delete;
 
   const SceneInfo& info() const;
-  // Never throws for a bad state: request_error / server_error say what went wrong.
-  std::shared_ptr<RenderedFrame> render(const ViewState& state);
+  std::shared_ptr<RenderedFrame> render(const ViewState& state) override;
 
  private:
   struct Impl;

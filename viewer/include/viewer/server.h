@@ -12,8 +12,8 @@
 #pragma once
 
 #include "common/json.h"
+#include "viewer/frame_source.h"
 #include "viewer/request.h"
-#include "viewer/scene.h"
 
 #include <string>
 
@@ -33,9 +33,10 @@ struct ServedInfo {
   ViewState defaults;
 };
 
-// Prints "prtr view: http://HOST:PORT/" on stdout (flushed), then serves and renders until
-// SIGINT or SIGTERM, and returns normally. Throws std::runtime_error when it cannot listen.
-void serve_view(ViewScene& scene, const ServedInfo& served, const ServerOptions& options);
+// Prints "prtr view: http://HOST:PORT/" on stdout (flushed), then serves and renders (with
+// `scene`, on the calling thread) until SIGINT or SIGTERM, and returns normally. Throws
+// std::runtime_error when it cannot listen.
+void serve_view(FrameSource& scene, const ServedInfo& served, const ServerOptions& options);
 
 // The X-Prtr-Frame header of a frame: its state and timings.
 common::Json frame_header(const RenderedFrame& frame);
