@@ -501,6 +501,14 @@ if [[ -f $forest ]]; then
   expect_code 2 && [[ $err == *"too small"* ]]; check "slf: an atlas too small for the mesh is a usage error" $?
   run slf "$tmp/cube.obj" --probe "$forest" --samples 32 -o "$tmp/x.slfc" -q
   expect_code 2 && [[ $err == *--samples* ]]; check "slf: --samples without WxH is a usage error naming it" $?
+  # The chart method travels in the file: a per-triangle .slfc says so, and every command that
+  # rebuilds its atlas (render, view, relight) rebuilds that one, not the default.
+  run slf "$tmp/cube.obj" --probe "$forest" --charts per-triangle --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/tri.slfc" --no-cache -q
+  expect_code 0; check "slf --charts per-triangle exits 0" $?
+  run info "$tmp/tri.slfc" --json
+  expect_code 0 && [[ $(jget - /atlas_charts <<<"$out") == per-triangle ]]; check "info: a per-triangle .slfc says so" $?
+  run render "$tmp/tri.slfc" --probe "$forest" --width 16 --height 12 --frames 1 --warmup 0 -o "$tmp/tri.exr" -q
+  expect_code 0 && [[ -s $tmp/tri.exr ]]; check "render: a per-triangle .slfc renders with its own atlas ($err)" $?
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 -o "$tmp/pt.exr" -q
   expect_code 0 && [[ -s $tmp/pt.exr ]]; check "path-trace writes an EXR" $?
   # prtr render shows the .slfc in one pass; PRT's lighting flags and another probe are refused.

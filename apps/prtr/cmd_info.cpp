@@ -246,6 +246,7 @@ void describe_compressed(const std::string& path, const std::string& mesh,
 void slf_shape_json(Json& j, const prt::SlfShape& b) {
   j["atlas_width"] = b.atlas_width;
   j["atlas_height"] = b.atlas_height;
+  j["atlas_charts"] = meshes::kAtlasChartsNames.name(b.charts);
   j["directions_azimuth"] = b.grid.azimuth;
   j["directions_polar"] = b.grid.elevation;
   j["directions"] = b.grid.directions();
@@ -262,7 +263,8 @@ void slf_shape_json(Json& j, const prt::SlfShape& b) {
 }
 
 void print_slf_shape(const prt::SlfShape& b) {
-  std::printf("atlas       %d x %d texels, %llu owned (the rows)\n", b.atlas_width, b.atlas_height,
+  std::printf("atlas       %d x %d texels, %s charts, %llu owned (the rows)\n", b.atlas_width,
+              b.atlas_height, std::string(meshes::kAtlasChartsNames.name(b.charts)).c_str(),
               u(b.rows));
   std::printf("directions  %d x %d (azimuth x polar): %d, x 3 channels = %llu floats per row\n",
               b.grid.azimuth, b.grid.elevation, b.grid.directions(), u(b.columns()));

@@ -414,7 +414,8 @@ void run_slf(const Options& o, Clock::time_point start) {
       "compress    compressed %d cluster(s), %d PC(s): ratio %.1f, RMS error %.3g%% (%.1f s)\n",
       r.slf.set.cluster_count, r.slf.set.component_count, r.ratio, 100 * r.relative_rms_error,
       r.compress_seconds);
-  const meshes::Atlas atlas = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height);
+  const meshes::Atlas atlas =
+      meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
   const render::SlfModel model =
       render::slf_model_from_compressed(mesh, atlas, r.slf.bake.grid, r.slf.set);
 

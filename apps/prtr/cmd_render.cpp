@@ -7,14 +7,13 @@
 #include "gl_flags.h"
 #include "mesh_flags.h"
 #include "render/pass_grouping.h"
+#include "slf_input.h"
 #include "supersample_flag.h"
 #include "view_flags.h"
 
 #include "cpca/compressed_file.h"
 #include "cpca/supercluster_strategy.h"
-#include "meshes/atlas.h"
 #include "meshes/load.h"
-#include "pipeline/slf_file.h"
 #include "probes/load.h"
 #include "prt/projection.h"
 #include "prt/sh_rotation.h"
@@ -23,14 +22,12 @@
 #include "render/gl_context.h"
 #include "render/image.h"
 #include "render/renderer.h"
-#include "render/slf_from_compressed.h"
 #include "render/slf_renderer.h"
 #include "render/supersample.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -221,13 +218,6 @@ void print_report(const Options& o, const render::RenderStats& st,
   }
 }
 
-// A compressed surface light field (.slfc) rather than a PRT set: its first bytes say so.
-bool is_slfc(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[8] = {};
-  return in.read(magic, sizeof magic) && std::string(magic, sizeof magic) == "PRTRSLFC";
-}
-
 // prtr render SET.slfc: the surface light field seen from the camera in one pass. Its
 // lighting is baked, so only the camera moves; the probe is the background and must be the
 // one it was baked under.
@@ -240,29 +230,11 @@ void run_slf(const Options& o, CLI::App* cmd) {
                        " is a surface light field, whose lighting is baked and which renders "
                        "in one pass");
   const render::GlSelection gl = gl_selection(o.gl);
-  const pipeline::CompressedSlf slf = pipeline::read_slfc(o.compressed);
-  if (!slf.complete())
-    throw std::runtime_error(o.compressed + " holds only rows " +
-                             std::to_string(slf.bake.first_row) + " to " +
-                             std::to_string(slf.bake.first_row + slf.bake.row_count) + " of " +
-                             std::to_string(slf.bake.rows) +
-                             " (a measurement made with --rows); make it without --rows");
-  const std::string mesh_path = o.mesh.empty() ? slf.mesh_path : o.mesh;
-  const meshes::Mesh mesh = meshes::load_mesh(mesh_path, load_options(o.mesh_flags));
-  if (meshes::content_hash(mesh) != slf.bake.mesh_hash)
-    throw std::runtime_error(o.compressed + " was made from a different mesh than " + mesh_path +
-                             " (stale); make it again, or pass the right --mesh (and the "
-                             "--crease-angle it was made with)");
-  const probes::Probe probe = probes::load_probe(o.probe);
-  if (prt::probe_hash(probe) != slf.bake.probe_hash)
-    throw UsageError("--probe: " + o.compressed + " was baked under " + slf.probe_name + ", not " +
-                     o.probe +
-                     "; a surface light field's lighting is fixed, so "
-                     "pass the probe it was made with");
-  const meshes::Atlas atlas =
-      meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height, {slf.bake.charts});
-  const render::SlfModel model =
-      render::slf_model_from_compressed(mesh, atlas, slf.bake.grid, slf.set);
+  const SlfInput input = load_slf_input(o.compressed, o.mesh, o.mesh_flags, o.probe);
+  const pipeline::CompressedSlf& slf = input.slf;
+  const meshes::Mesh& mesh = input.mesh;
+  const probes::Probe& probe = input.probe;
+  const render::SlfModel& model = input.model;
   const render::Background background = resolve_background(o.view);
   const render::Camera camera = resolve_camera(o.view, mesh);
 

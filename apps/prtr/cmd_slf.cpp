@@ -97,7 +97,8 @@ pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probe
   if (!o.rows.empty()) throw UsageError("--rows and mpirun both split the rows: use one of them");
   std::uint64_t rows = 0;
   try {
-    rows = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height).used_texels();
+    rows = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts})
+               .used_texels();
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());  // an atlas too small for the mesh
   }
@@ -122,7 +123,7 @@ pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probe
         bar.update("slf bake (rank 0's rows)", done, total);
       };
       const meshes::Atlas atlas =
-          meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height);
+          meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
       prt::bake_slf_to_file(mesh, atlas, probe, bake, part(world.rank));
       bar.finish();
     } catch (const std::exception& e) {

@@ -41,7 +41,7 @@ SlfInput load_slf_input(const std::string& slfc, const std::string& mesh,
                      "; a surface light field's lighting is fixed, so pass the probe it was "
                      "made with");
   const meshes::Atlas atlas =
-      meshes::make_atlas(in.mesh, slf.bake.atlas_width, slf.bake.atlas_height);
+      meshes::make_atlas(in.mesh, slf.bake.atlas_width, slf.bake.atlas_height, {slf.bake.charts});
   in.model = render::slf_model_from_compressed(in.mesh, atlas, slf.bake.grid, slf.set);
   return in;
 }
