@@ -30,8 +30,7 @@ def measure(browser, url, mode, width, height, seconds):
     browser.wait_for("Number(document.getElementById('stat-frames').textContent) >= 1",
                      timeout=600, what="the first frame")
     time.sleep(1.0)
-    rect = browser.evaluate("(() => { const r = document.getElementById('frame')"
-                            ".getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })()")
+    rect = browser.rect("frame")
     y = rect[1] + rect[3] / 2
     browser.evaluate("window.prtrLog.length = 0")
     start = time.monotonic()

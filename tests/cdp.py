@@ -122,6 +122,12 @@ class Browser:
             params["clickCount"] = 1
         self.call("Input.dispatchMouseEvent", params)
 
+    def rect(self, element_id):
+        """The element's [x, y, width, height] in CSS pixels."""
+        return self.evaluate("(() => { const r = document.getElementById(%r)"
+                             ".getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })()"
+                             % element_id)
+
     def drag(self, x0, y0, dx, dy, steps=10, modifiers=0, pause=0.0):
         self.mouse("mousePressed", x0, y0, buttons=1, modifiers=modifiers)
         for i in range(1, steps + 1):

@@ -215,8 +215,7 @@ def run(browser, server, tmp):
     check("the still view is refined to 2 x 2 samples", text(browser, "stat-aa") == "2 × 2")
     env0 = text(browser, "stat-env")
 
-    rect = browser.evaluate("(() => { const r = document.getElementById('frame')"
-                            ".getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })()")
+    rect = browser.rect("frame")
     cx, cy = rect[0] + rect[2] / 2, rect[1] + rect[3] / 2
     n = frames(browser)
     browser.drag(cx - 60, cy, 120, 20)

@@ -103,8 +103,7 @@ def check_page(browser, server, tmp):
     browser.wait_for("document.getElementById('stat-aa').textContent === '2 × 2'",
                      what="the still view anti-aliased")
     still = browser.evaluate(PIXELS)
-    rect = browser.evaluate("(() => { const r = document.getElementById('frame')"
-                            ".getBoundingClientRect(); return [r.x, r.y, r.width, r.height]; })()")
+    rect = browser.rect("frame")
     cx, cy = rect[0] + rect[2] / 2, rect[1] + rect[3] / 2
     n = frames(browser)
     browser.drag(cx - 60, cy, 120, 20)

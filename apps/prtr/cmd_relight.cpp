@@ -384,15 +384,7 @@ void run_slf(const Options& o, Clock::time_point start) {
   settings.bake.seed = o.bake.bake.seed;
   settings.bake.material = resolve_material_flags(o.bake.material);
   settings.compress = resolve_compress_flags(o.compress);
-  if (settings.compress.alpha > 0 || settings.compress.overdraw_reduction)
-    throw UsageError(
-        "--alpha and --overdraw-reduction need mesh vertices; a surface light field's rows "
-        "are atlas texels");
-  try {
-    settings.bake.validate();
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  check_slf_settings(settings);
   const Eigen::Vector3d axis = resolve_axis(o.view);
   const render::Background background = resolve_background(o.view);
   const render::GlSelection gl = gl_selection(o.gl);

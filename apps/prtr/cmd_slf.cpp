@@ -162,15 +162,7 @@ void run(const Options& o, CLI::App*) {
   settings.bake.ray_offset = o.ray_offset;
   settings.bake.material = resolve_material_flags(o.material);
   settings.compress = resolve_compress_flags(o.compress);
-  if (settings.compress.alpha > 0 || settings.compress.overdraw_reduction)
-    throw UsageError(
-        "--alpha and --overdraw-reduction need mesh vertices; an SLF's rows are "
-        "atlas texels");
-  try {
-    settings.bake.validate();
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  check_slf_settings(settings);
   const meshes::Mesh mesh = meshes::load_mesh(o.mesh, load_options(o.mesh_flags));
   const probes::Probe probe = probes::load_probe(o.probe);
   const std::string probe_name = fs::path(o.probe).filename().string();

@@ -4,6 +4,7 @@
 #include "flag_checks.h"
 
 #include <cstdio>
+#include <stdexcept>
 #include <utility>
 
 namespace prtr_app {
@@ -48,6 +49,18 @@ void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
   std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
       parse_size(f.directions, "--directions", 1, 4096);
   settings.bake.spp = f.spp;
+}
+
+void check_slf_settings(const pipeline::SlfSettings& settings) {
+  if (settings.compress.alpha > 0 || settings.compress.overdraw_reduction)
+    throw UsageError(
+        "--alpha and --overdraw-reduction need mesh vertices; a surface light field's rows "
+        "are atlas texels");
+  try {
+    settings.bake.validate();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
 }
 
 }  // namespace prtr_app

@@ -26,4 +26,8 @@ void add_slf_flags(CLI::App* command, SlfFlags& flags, const char* samples_flag)
 // flag.
 void resolve_slf_flags(const SlfFlags& flags, pipeline::SlfSettings& settings);
 
+// UsageErrors for settings a surface light field cannot take: the compression's mesh-vertex
+// terms (its rows are atlas texels) and bake settings out of range.
+void check_slf_settings(const pipeline::SlfSettings& settings);
+
 }  // namespace prtr_app
