@@ -2,6 +2,7 @@
 // the CPU reference's image (render/slf_reference.h) from the camera worked out by hand for
 // that orbit and zoom, supersampled frames are the filtered larger reference, and every state
 // a baked light field cannot show is refused with its reason, naming the parameter first.
+#include "viewer/server.h"
 #include "viewer/slf_scene.h"
 
 #include "meshes/atlas.h"
@@ -127,6 +128,7 @@ TEST(ViewSlfScene, FrameIsTheReferenceFromTheOrbitedCamera) {
   EXPECT_GT(covered(cpu), 64 * 48 / 4);
   EXPECT_LE(differing(frame->image, cpu, kTolerance), kEdgePixels);
   EXPECT_EQ(frame->stats.passes, 1);
+  EXPECT_EQ(viewer::frame_header(*frame).at("kind"), "slf");  // the page's and X-Prtr-Frame's
   EXPECT_EQ(frame->stats.clusters, 4);
   EXPECT_EQ(frame->stats.pcs, 3);
 

@@ -182,7 +182,8 @@ void render_jobs(FrameSource& scene, FrameQueue& queue) {
 Json frame_header(const RenderedFrame& f) {
   const ViewState& s = f.state;
   const FrameStats& t = f.stats;
-  return Json{{"seq", s.seq},
+  return Json{{"kind", t.kind},
+              {"seq", s.seq},
               {"width", s.width},
               {"height", s.height},
               {"mode", render::kModeNames.name(s.mode)},

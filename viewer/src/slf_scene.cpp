@@ -81,6 +81,7 @@ void SlfScene::Impl::render_into(RenderedFrame& frame) {
   frame.stats.frame_ms = t.total_ms;
   frame.stats.cpu_ms = t.cpu_ms;
   frame.stats.gl_ms = t.gl_ms;
+  frame.stats.kind = "slf";
   frame.stats.passes = 1;
   frame.stats.clusters_per_pass = clusters;
   frame.stats.clusters = clusters;

@@ -17,10 +17,11 @@
 namespace viewer {
 
 struct FrameStats {
-  double queue_ms = 0;     // submitted -> taken by the render thread
-  double render_ms = 0;    // renderer set-up (if any) + frame + read-back
-  double frame_ms = 0;     // Renderer::render alone (what render_bench times)
-  double readback_ms = 0;  // Renderer::read_image: the float framebuffer to memory
+  const char* kind = "prt";  // what drew it: "prt" (modes, passes) or "slf" (one pass, baked light)
+  double queue_ms = 0;       // submitted -> taken by the render thread
+  double render_ms = 0;      // renderer set-up (if any) + frame + read-back
+  double frame_ms = 0;       // Renderer::render alone (what render_bench times)
+  double readback_ms = 0;    // Renderer::read_image: the float framebuffer to memory
   double cpu_ms = 0, gl_ms = 0;
   double overlay_ms = 0;  // CPU false-colour picture
   double setup_ms = 0;    // a new renderer (grouping, upload) or probe, when this frame needed one
