@@ -224,7 +224,9 @@ bool is_embedded_disk(const std::vector<Eigen::Vector2d>& uv,
   };
   for (int e = 0; e < int(boundary.size()); ++e) {
     bool meets = false;
-    const auto [a, b] = boundary[e];
+    // Plain names, not a structured binding: C++17 lambdas (clang 14, the fuzz build's
+    // compiler) cannot capture those.
+    const int a = boundary[e].first, b = boundary[e].second;
     cells(e, [&](std::vector<int>& list) {
       for (int other : list) {
         if (meets) return;
