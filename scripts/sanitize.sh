@@ -59,6 +59,21 @@ export LSAN_OPTIONS=suppressions=$supp:print_suppressions=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 status=0
 (cd "$dir" && ctest --output-on-failure -j "$jobs" "$@") || status=$?
+# LeakSanitizer stops every thread with ptrace at exit, and its tracer can itself crash ("Tracer
+# caught signal 11 ... LeakSanitizer has encountered a fatal error") after a test has passed:
+# a fault of the checker, not a finding, seen once in some twenty runs of the suite, in a GL
+# test whose repeats all pass. Only then, and only when no sanitizer reported anything, the
+# failed tests run once more, and the retry is announced.
+log=$dir/Testing/Temporary/LastTest.log
+if ((status != 0)) && [[ -f $log ]] &&
+   grep -q "LeakSanitizer has encountered a fatal error" "$log" &&
+   ! grep -qE "ERROR: (AddressSanitizer|LeakSanitizer: detected)|runtime error:|\[  FAILED  \]" "$log"; then
+  echo "sanitize: LeakSanitizer's tracer crashed in a test that passed; running the failed" \
+    "tests once more:" >&2
+  cat "$dir/Testing/Temporary/LastTestsFailed.log" >&2 || true
+  status=0
+  (cd "$dir" && ctest --output-on-failure --rerun-failed) || status=$?
+fi
 done_at=$(date +%s)
 echo "sanitize: $compiler, build $((built - start)) s, tests $((done_at - built)) s," \
   "$([[ $status == 0 ]] && echo passed || echo FAILED)" >&2
