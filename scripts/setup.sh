@@ -32,6 +32,9 @@ packages=(
   libopenimageio-dev openimageio-tools libtbb-dev libcli11-dev
   libmetis-dev libmeshoptimizer-dev nlohmann-json3-dev
   libassimp-dev  # glTF 2.0 (.gltf, .glb) and 3DS import, meshes/src/read_assimp.cpp
+  zlib1g-dev     # Debian's assimp CMake config links /usr/lib/.../libz.so, but libassimp-dev
+                 # does not depend on zlib1g-dev (cpp-httplib's package brought it until the
+                 # viewer dropped it; the test packages still do, so only the main job broke)
   ffmpeg                # the MP4 of prtr relight (and ffprobe for its test)
   libturbojpeg0-dev     # prtr view: JPEG frames
   glmark2-data blender-data
