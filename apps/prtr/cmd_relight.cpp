@@ -15,7 +15,6 @@
 #include "flag_checks.h"
 #include "gl_flags.h"
 #include "mesh_flags.h"
-#include "meshes/atlas.h"
 #include "meshes/load.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/slf.h"
@@ -28,10 +27,10 @@
 #include "render/image.h"
 #include "render/pass_grouping.h"
 #include "render/renderer.h"
-#include "render/slf_from_compressed.h"
 #include "render/slf_renderer.h"
 #include "render/supersample.h"
 #include "slf_flags.h"
+#include "slf_input.h"
 #include "supersample_flag.h"
 #include "view_flags.h"
 
@@ -406,16 +405,10 @@ void run_slf(const Options& o, Clock::time_point start) {
       "compress    compressed %d cluster(s), %d PC(s): ratio %.1f, RMS error %.3g%% (%.1f s)\n",
       r.slf.set.cluster_count, r.slf.set.component_count, r.ratio, 100 * r.relative_rms_error,
       r.compress_seconds);
-  const meshes::Atlas atlas =
-      meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
-  const render::SlfModel model =
-      render::slf_model_from_compressed(mesh, atlas, r.slf.bake.grid, r.slf.set);
+  const render::SlfModel model = slf_render_model(mesh, r.slf);
 
   render::GlContext context(gl);
-  render::SlfRendererOptions ro;
-  // As prtr render draws a .slfc (the same image): the deferred pass on a software rasteriser.
-  ro.deferred = context.info().software_rasterizer();
-  render::SlfRenderer renderer(model, &probe, ro);
+  render::SlfRenderer renderer(model, &probe);
   renderer.set_background(background);
   const render::Camera big = render::supersampled(camera, o.supersample);
   const Eigen::Vector3d centre = mesh_centre(mesh);
@@ -424,8 +417,8 @@ void run_slf(const Options& o, Clock::time_point start) {
       [&](render::Image& samples) { renderer.read_image(samples); }};
   char line[200];
   std::snprintf(line, sizeof line, "slf, %s, %d x %d texels, %d x %d directions",
-                ro.deferred ? "one shading pass after a uv pass" : "one pass", model.map_width,
-                model.map_height, model.grid.azimuth, model.grid.elevation);
+                renderer.deferred() ? "one shading pass after a uv pass" : "one pass",
+                model.map_width, model.map_height, model.grid.azimuth, model.grid.elevation);
   render_outputs(o, camera, source, line, start);
 }
 

@@ -241,9 +241,6 @@ void run_slf(const Options& o, CLI::App* cmd) {
   render::GlContext context(gl);
   render::SlfRendererOptions ro;
   ro.cull_back_faces = !o.no_cull;
-  // llvmpipe shades whole 4 x 4 blocks, so small triangles cost the one-pass shader several
-  // times their pixels; the deferred pass (same image) shades each covered pixel once.
-  ro.deferred = context.info().software_rasterizer();
   render::SlfRenderer renderer(model, &probe, ro);
   renderer.set_background(background);
   for (int i = 0; i < o.warmup; ++i) renderer.render(camera);
@@ -261,7 +258,7 @@ void run_slf(const Options& o, CLI::App* cmd) {
     std::printf(
         "slf         %s, %d cluster(s), %d PCA term(s), %d x %d texels, %d x %d "
         "directions, baked under %s\n",
-        ro.deferred ? "one shading pass after a uv pass" : "one pass", model.clusters,
+        renderer.deferred() ? "one shading pass after a uv pass" : "one pass", model.clusters,
         model.components, model.map_width, model.map_height, model.grid.azimuth,
         model.grid.elevation, slf.probe_name.c_str());
     std::printf("timing      %.2f FPS: frame %.2f ms median over %d frames\n",

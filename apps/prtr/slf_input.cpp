@@ -19,6 +19,12 @@ bool is_slfc(const std::string& path) {
   return in.read(magic, sizeof magic) && std::string(magic, sizeof magic) == "PRTRSLFC";
 }
 
+render::SlfModel slf_render_model(const meshes::Mesh& mesh, const pipeline::CompressedSlf& slf) {
+  const meshes::Atlas atlas =
+      meshes::make_atlas(mesh, slf.bake.atlas_width, slf.bake.atlas_height, {slf.bake.charts});
+  return render::slf_model_from_compressed(mesh, atlas, slf.bake.grid, slf.set);
+}
+
 SlfInput load_slf_input(const std::string& slfc, const std::string& mesh,
                         const MeshFlags& mesh_flags, const std::string& probe) {
   SlfInput in;
@@ -40,9 +46,7 @@ SlfInput load_slf_input(const std::string& slfc, const std::string& mesh,
     throw UsageError("--probe: " + slfc + " was baked under " + slf.probe_name + ", not " + probe +
                      "; a surface light field's lighting is fixed, so pass the probe it was "
                      "made with");
-  const meshes::Atlas atlas =
-      meshes::make_atlas(in.mesh, slf.bake.atlas_width, slf.bake.atlas_height, {slf.bake.charts});
-  in.model = render::slf_model_from_compressed(in.mesh, atlas, slf.bake.grid, slf.set);
+  in.model = slf_render_model(in.mesh, slf);
   return in;
 }
 

@@ -18,6 +18,10 @@ namespace prtr_app {
 // A .slfc rather than a mesh or a PRT set: its first bytes say so.
 bool is_slfc(const std::string& path);
 
+// The renderer's model of `slf` on `mesh`: the atlas rebuilt as the file records it (size and
+// chart method; it is deterministic), then each texel's cluster, weights and view maps.
+render::SlfModel slf_render_model(const meshes::Mesh& mesh, const pipeline::CompressedSlf& slf);
+
 struct SlfInput {
   pipeline::CompressedSlf slf;
   std::string mesh_path;  // the mesh loaded: --mesh, or the path the file records

@@ -247,7 +247,8 @@ struct SlfRenderer::Impl {
   void bind_textures();
 
   SlfRendererOptions options;
-  SlfModel shape;  // sizes only (the arrays are uploaded and dropped)
+  bool deferred = false;  // options.deferred, resolved against the context
+  SlfModel shape;         // sizes only (the arrays are uploaded and dropped)
   slf_gl::TileLayout tiles;
   GLuint vao = 0, vbo = 0, cluster_texture = 0, views_texture = 0, weights_texture = 0;
   GLuint uv_texture = 0;  // deferred: the pre-pass's atlas coordinates, at the frame's size
@@ -261,7 +262,9 @@ struct SlfRenderer::Impl {
 
 SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
                         const SlfRendererOptions& renderer_options)
-    : options(renderer_options), background_pass(probe) {
+    : options(renderer_options),
+      deferred(renderer_options.deferred.value_or(current_gl_info().software_rasterizer())),
+      background_pass(probe) {
   model.validate();
   shape.map_width = model.map_width;
   shape.map_height = model.map_height;
@@ -370,7 +373,7 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
 }
 
 void SlfRenderer::Impl::build_program() {
-  if (options.deferred) {
+  if (deferred) {
     program =
         GlProgram("surface light field (deferred shading)", slf_gl::fullscreen_vertex_shader(),
                   slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path, true));
@@ -480,7 +483,7 @@ void SlfRenderer::Impl::draw(const Camera& camera) {
   } else {
     glDisable(GL_CULL_FACE);
   }
-  if (options.deferred) {
+  if (deferred) {
     draw_deferred(camera);
   } else {
     program.use();
@@ -511,11 +514,17 @@ void SlfRenderer::set_probe(const probes::Probe* probe) {
 }
 
 void SlfRenderer::set_options(const SlfRendererOptions& options) {
+  const bool deferred = options.deferred.value_or(current_gl_info().software_rasterizer());
   const bool rebuild =
       options.shared_cluster_fast_path != impl_->options.shared_cluster_fast_path ||
-      options.deferred != impl_->options.deferred;
+      deferred != impl_->deferred;
   impl_->options = options;
+  impl_->deferred = deferred;
   if (rebuild) impl_->build_program();
+}
+
+bool SlfRenderer::deferred() const {
+  return impl_->deferred;
 }
 
 FrameTiming SlfRenderer::render(const Camera& camera) {

@@ -93,9 +93,6 @@ SlfScene::SlfScene(SlfSceneInputs inputs) : impl_(std::make_unique<Impl>(std::mo
   m.info = context_scene_info(m.context.info());
   render::SlfRendererOptions ro;
   ro.cull_back_faces = m.inputs.cull_back_faces;
-  // llvmpipe shades whole 4 x 4 blocks, so small triangles cost the one-pass shader several
-  // times their pixels; the deferred pass (the same image) shades each covered pixel once.
-  ro.deferred = m.context.info().software_rasterizer();
   m.renderer = std::make_unique<render::SlfRenderer>(*m.inputs.model, m.inputs.probe, ro);
   m.renderer->set_background(m.inputs.background);
   m.clusters = m.inputs.model->clusters;

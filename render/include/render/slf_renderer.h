@@ -41,6 +41,7 @@
 #include "render/slf_model.h"
 
 #include <memory>
+#include <optional>
 
 namespace render {
 
@@ -49,8 +50,11 @@ struct SlfRendererOptions {
   // Sum the texels cluster by cluster (see above); false reconstructs each of the four
   // texels on its own, to measure the difference.
   bool shared_cluster_fast_path = true;
-  // Shade after a uv pre-pass instead of in the mesh's own pass (see above).
-  bool deferred = false;
+  // Shade after a uv pre-pass instead of in the mesh's own pass (see above). Unset: the
+  // context decides, deferred on a software rasterizer (llvmpipe shades whole 4 x 4 blocks,
+  // so small triangles cost the one-pass shader several times their pixels), one pass on a
+  // GPU. The image is the same either way.
+  std::optional<bool> deferred{};
 };
 
 class SlfRenderer {
@@ -67,6 +71,8 @@ class SlfRenderer {
 
   // The probe (when there is one and use_probe is set) or the solid colour behind the mesh.
   void set_background(const Background& background);
+  // Whether frames are shaded after a uv pre-pass: the option, or the context's choice.
+  bool deferred() const;
   void set_probe(const probes::Probe* probe);
   void set_options(const SlfRendererOptions& options);
 
