@@ -317,6 +317,29 @@ if [[ -f $forest ]]; then
     read -r se0 se3 o3 b3 < <(jget - /rows/0/average_se /rows/3/average_se /rows/3/average_overdraw /rows/3/overdraw_bound <<<"$out" | tr '\n' ' ')
     awk -v a="$se0" -v b="$se3" -v o="$o3" -v l="$b3" 'BEGIN { exit !(b <= a * (1 + 1e-6) && l >= 1 && l <= o) }'
     check "overdraw: patch-eps keeps Average SE ($se3) within original's ($se0), overdraw $o3 >= its bound $b3" $?
+    # The image RMSE is pooled over --image-rotations environment rotations (37 + 120 k deg
+    # here): recomputed from prtr render and prtr compare at each rotation.
+    transfer=$(jget - /transfer <<<"$out")
+    run overdraw "$cat3ds" --probe "$forest" --transfer "$transfer" --clusters 16 --pcs 2 --rows original \
+      --strategies order --budgets thesis --frames 1 --warmup 0 --rounds 1 --width 64 --height 48 \
+      --no-modes --image-rotations 3 --cache "$tmp/odr_cache" --out "$tmp/odr" -q --json
+    expect_code 0; check "overdraw --image-rotations 3 runs ($err)" $?
+    rmse=$(jget - /rows/0/image_rmse <<<"$out")
+    prtc=$(ls "$tmp"/odr_cache/cpca-*.prtc)
+    # prtr overdraw frames the bounding box's sphere (render::frame_sphere): the same camera.
+    read -r eye target < <("$prtr" mesh "$cat3ds" | python3 -c 'import math,re,sys
+t=sys.stdin.read(); b=[float(x) for x in re.search(r"min \((.*)\)  max \((.*)\)", t).group(1,2)[0].split(", ")+re.search(r"max \((.*)\)", t).group(1).split(", ")]
+c=[(b[i]+b[i+3])/2 for i in range(3)]; r=math.dist(b[:3],b[3:])/2; ty=math.tan(math.radians(20)); s=ty/math.sqrt(1+ty*ty)
+print("%r,%r,%r %r,%r,%r"%(c[0],c[1],c[2]+1.05*r/s,*c))')
+    pooled=0
+    for deg in 37 157 277; do
+      rr=(render "$prtc" --probe "$forest" --mesh "$cat3ds" --width 64 --height 48 --supersample 1
+          --background black --frames 1 --warmup 0 --spin-deg 0 --rotate-deg $deg --eye "$eye" --target "$target" -q)
+      "$prtr" "${rr[@]}" -o "$tmp/odr/m.exr" && "$prtr" "${rr[@]}" --mode uncompressed --transfer "$transfer" -o "$tmp/odr/u.exr"
+      pooled="$pooled $("$prtr" compare "$tmp/odr/m.exr" "$tmp/odr/u.exr" --coverage 0.5 --json)"
+    done
+    python3 -c 'import json,math,sys; r=[json.loads(x) for x in sys.argv[2:]]; n=sum(x["pixels"] for x in r); p=math.sqrt(sum(x["rmse"]**2*x["pixels"] for x in r)/n); sys.exit(abs(p-float(sys.argv[1]))>1e-3*p)' "$rmse" ${pooled#0 }
+    check "overdraw: image RMSE ($rmse) is the RMSE pooled over 3 rotations of prtr render" $?
   fi
   run overdraw "$tmp/cube.obj" --probe "$forest" --rows bogus; expect_code 2 && [[ $err == *--rows* ]]; check "overdraw: unknown row is a usage error" $?
   run overdraw "$tmp/cube.obj" --probe "$forest" --strategies best; expect_code 2 && [[ $err == *--strategies* ]]; check "overdraw: unknown strategy is a usage error" $?

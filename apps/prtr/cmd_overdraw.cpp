@@ -45,6 +45,7 @@ struct Options {
   std::string strategies = "order,greedy,greedy-refine,metis,ils", budgets = "default,thesis";
   int frames = 10, warmup = 2, rounds = 3, width = 1280, height = 948;
   double degrees_per_frame = 1.0;
+  int image_rotations = 12;
   BakeFlags bake;
   CompressFlags compress;
   GlFlags gl;
@@ -112,6 +113,10 @@ void add_flags(CLI::App* cmd, Options& o) {
                      integer_in(0, 100000));
   add_checked_option(cmd, "--degrees-per-frame", o.degrees_per_frame,
                      "Environment rotation per frame about +Y while timing", angle_degrees());
+  add_checked_option(cmd, "--image-rotations", o.image_rotations,
+                     "Environment rotations about +Y (evenly spaced from 37 deg) the image RMSE "
+                     "is pooled over",
+                     integer_in(1, 360));
   add_checked_option(cmd, "--width", o.width, "Image width", integer_in(1, 16384));
   add_checked_option(cmd, "--height", o.height, "Image height", integer_in(1, 16384));
   cmd->add_option("--out", o.out, "Directory for CSV, JSON, plot and pictures")
@@ -160,6 +165,7 @@ OverdrawPlan make_plan(const Options& o, const CLI::App* cmd) {
   plan.width = o.width;
   plan.height = o.height;
   plan.degrees_per_frame = o.degrees_per_frame;
+  plan.image_rotations = o.image_rotations;
   plan.modes = !o.no_modes;
   plan.reporter = stderr_reporter(o.quiet);
   plan.gl = gl_selection(o.gl);

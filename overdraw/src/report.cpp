@@ -61,9 +61,13 @@ std::string markdown_preamble(const OverdrawReport& r) {
          std::to_string(r.rounds) +
          " rounds taken round-robin over the rows, environment rotating " +
          format("%g", r.degrees_per_frame) + " deg/frame about +Y; " + r.gl_renderer + ".\n";
-  out += "Image RMSE: multipass render vs the uncompressed render, environment rotated " +
-         format("%g", r.image_rotation_degrees) +
-         " deg, over covered pixels; in brackets relative to the reference's RMS.\n";
+  out += "Image RMSE: multipass render vs the uncompressed render, pooled over covered pixels " +
+         (r.image_rotations > 1
+              ? "and " + std::to_string(r.image_rotations) + " environment rotations " +
+                    format("%g", r.image_rotation_degrees) + " + k x " +
+                    format("%g", 360.0 / r.image_rotations) + " deg"
+              : "with the environment rotated " + format("%g", r.image_rotation_degrees) + " deg") +
+         "; in brackets relative to the reference's RMS.\n";
   if (r.compressions_cached)
     out +=
         "Some compressions came from the cache; their clustering times are those measured "
@@ -352,6 +356,7 @@ std::string json(const OverdrawReport& r) {
                        {"fits", fit_json(r)},
                        {"degrees_per_frame", r.degrees_per_frame},
                        {"image_rotation_degrees", r.image_rotation_degrees},
+                       {"image_rotations", r.image_rotations},
                        {"gl_renderer", r.gl_renderer},
                        {"rows", std::move(rows)},
                        {"modes", std::move(modes)}};

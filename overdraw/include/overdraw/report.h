@@ -64,6 +64,7 @@ struct OverdrawReport {
   int rounds = 0;  // interleaved timing rounds: frames x rounds timed frames per row
   int registers_per_cluster = 0;
   double degrees_per_frame = 0, image_rotation_degrees = 0;
+  int image_rotations = 1;
   std::string gl_renderer;
   std::vector<OverdrawRow> rows;
   std::vector<ModeTiming> modes;

@@ -72,7 +72,11 @@ struct OverdrawPlan {
   cpca::CompressOptions compress;
   int frames = 10, warmup = 2, width = 1280, height = 948;
   int rounds = 3;  // interleaved timing rounds over all rows
-  double degrees_per_frame = 1.0, image_degrees = 37.0;
+  double degrees_per_frame = 1.0;
+  // Image errors: pooled over image_rotations environment rotations about +Y, evenly spaced
+  // from image_degrees.
+  double image_degrees = 37.0;
+  int image_rotations = 12;
   bool modes = true;            // single-pass / decoupled / uncompressed timings
   pipeline::Reporter reporter;  // the bake's progress and notes; cache repairs (warnings)
   render::GlSelection gl;       // the backend every row renders on
