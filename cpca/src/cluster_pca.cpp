@@ -35,7 +35,8 @@ void for_each_member_row(const RowBlocks& x, const std::vector<std::uint32_t>& m
 std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolver solver,
                                  const PowerIterationOptions& power, ClusterPcaStats* stats,
                                  const std::function<bool(int)>& fits = {},
-                                 const std::vector<float>* warm = nullptr) {
+                                 const std::vector<float>* warm = nullptr,
+                                 const std::vector<const Eigen::MatrixXd*>* grams = nullptr) {
   const int k = set.cluster_count, n = set.component_count;
   const Eigen::Index d = x.cols();
   set.vertex_count = std::uint64_t(x.rows());
@@ -76,8 +77,22 @@ std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolv
                 .cast<double>();
         po.start = &start;
       }
-      const PcaResult pca = solver == PcaSolver::kEigen ? eigen_pca(f, rank_limit)
-                                                        : power_iteration_pca(f, rank_limit, po);
+      const Eigen::MatrixXd* gram = grams ? (*grams)[std::size_t(c)] : nullptr;
+      PcaResult pca;
+      if (solver == PcaSolver::kEigen) {
+        pca = eigen_pca(f, rank_limit);
+      } else if (gram && rows < d) {
+        // Centred from the caller's uncentred x_i . x_j: (x_i - mu) . (x_j - mu) =
+        // G_ij - r_i - r_j + s with r_i = x_i . mu (the mean of row i of G), s = mu . mu.
+        const Eigen::VectorXd r = gram->rowwise().mean();
+        Eigen::MatrixXd centred = *gram;
+        centred.colwise() -= r;
+        centred.rowwise() -= r.transpose();
+        centred.array() += r.mean();
+        pca = power_iteration_pca_gram(f, std::move(centred), rank_limit, po);
+      } else {
+        pca = power_iteration_pca(f, rank_limit, po);
+      }
       basis.topRows(rank_limit) = pca.basis;
       iterations += pca.iterations;
     }
@@ -121,14 +136,19 @@ std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaS
 
 std::vector<double> fit_cluster_pca_warm(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                          const std::vector<float>& previous_bases,
-                                         const PowerIterationOptions& power) {
+                                         const PowerIterationOptions& power,
+                                         const std::vector<const Eigen::MatrixXd*>& grams) {
+  if (!grams.empty() && grams.size() != std::size_t(set.cluster_count))
+    throw std::invalid_argument("fit_cluster_pca_warm: " + std::to_string(grams.size()) +
+                                " Gram matrices for " + std::to_string(set.cluster_count) +
+                                " clusters");
   if (previous_bases.size() !=
       std::size_t(set.cluster_count) * std::size_t(set.component_count) * std::size_t(x.cols()))
     throw std::invalid_argument("fit_cluster_pca_warm: the previous bases hold " +
                                 std::to_string(previous_bases.size()) +
                                 " floats, not clusters x components x dimension");
   return fit_clusters(RowBlocks(x), set, PcaSolver::kPowerIteration, power, nullptr, {},
-                      &previous_bases);
+                      &previous_bases, grams.empty() ? nullptr : &grams);
 }
 
 namespace {
@@ -263,7 +283,7 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
 DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
                               const Eigen::VectorXf& x_squared_norms, const CompressedSet& set,
                               int candidates) {
-  const int k = set.cluster_count, n = set.component_count;
+  const int k = set.cluster_count;
   if (candidates <= 0 || candidates >= k) return subspace_distances(x, x_squared_norms, set);
   const Eigen::Index v = x.rows(), d = x.cols();
   const Eigen::Map<const DataMatrix> means(set.means.data(), k, d);
@@ -291,21 +311,34 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
   DataMatrix out = DataMatrix::Constant(v, k, std::numeric_limits<float>::infinity());
   tbb::parallel_for(0, k, [&](int j) {
     const auto& members = points[std::size_t(j)];
-    if (members.empty()) return;
-    const Eigen::Index rows = Eigen::Index(members.size());
-    DataMatrix centred(rows, d);
-    for (Eigen::Index i = 0; i < rows; ++i)
-      centred.row(i) = x.row(members[std::size_t(i)]) - means.row(j);
-    Eigen::VectorXf residual = centred.rowwise().squaredNorm();
-    if (n > 0) {
-      const auto basis = set.basis(j);
-      const DataMatrix w = centred * basis.transpose();
-      residual -= w.rowwise().squaredNorm();
-    }
+    const std::vector<float> residual = subspace_residuals(x, set, j, members);
     // Columns of `out` are written by one task each: no two tasks touch the same entry.
-    for (Eigen::Index i = 0; i < rows; ++i)
-      out(members[std::size_t(i)], j) = std::max(0.f, residual[i]);
+    for (std::size_t i = 0; i < members.size(); ++i) out(members[i], j) = residual[i];
   });
+  return out;
+}
+
+std::vector<float> subspace_residuals(const Eigen::Ref<const DataMatrix>& x,
+                                      const CompressedSet& set, int cluster,
+                                      const std::vector<std::uint32_t>& points) {
+  // In chunks whose centred rows stay in cache for the product that reads them again: one
+  // centred copy of every point cost more in memory traffic than the product itself.
+  constexpr std::size_t kChunk = 64;
+  const Eigen::Index d = x.cols();
+  const auto mean = set.mean(cluster);
+  std::vector<float> out(points.size());
+  DataMatrix centred(Eigen::Index(std::min(kChunk, points.size())), d);
+  for (std::size_t begin = 0; begin < points.size(); begin += kChunk) {
+    const Eigen::Index rows = Eigen::Index(std::min(kChunk, points.size() - begin));
+    auto block = centred.topRows(rows);
+    for (Eigen::Index i = 0; i < rows; ++i)
+      block.row(i) = x.row(points[begin + std::size_t(i)]) - mean;
+    Eigen::VectorXf residual = block.rowwise().squaredNorm();
+    if (set.component_count > 0)
+      residual -= (block * set.basis(cluster).transpose()).rowwise().squaredNorm();
+    for (Eigen::Index i = 0; i < rows; ++i)
+      out[begin + std::size_t(i)] = std::max(0.f, residual[i]);
+  }
   return out;
 }
 

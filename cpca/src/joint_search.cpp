@@ -2,6 +2,7 @@
 
 #include "common/check.h"
 #include "cpca/assignment.h"
+#include "cpca/cluster_gram.h"
 #include "cpca/cluster_pca.h"
 #include "cpca/compress.h"
 #include "cpca/patch_first.h"
@@ -147,7 +148,7 @@ std::uint64_t swap_descent(const ClusterIncidence& inc, int per_pass,
 std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
                                   const CompressedSet& before, const std::vector<double>& error,
                                   CompressedSet& next, const JointSearchOptions& o,
-                                  bool warm = false) {
+                                  ClusterGrams* grams = nullptr) {
   std::vector<char> changed(std::size_t(next.cluster_count), 0);
   for (std::size_t p = 0; p < next.cluster_of.size(); ++p)
     if (next.cluster_of[p] != before.cluster_of[p])
@@ -170,13 +171,16 @@ std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
   power.seed = o.seed;
   const std::size_t d = next.dimension(), n = std::size_t(next.component_count);
   std::vector<double> part_error;
-  if (warm && o.solver == PcaSolver::kPowerIteration) {
+  if (grams && o.solver == PcaSolver::kPowerIteration) {
     std::vector<float> previous(ids.size() * n * d);
     for (std::size_t j = 0; j < ids.size(); ++j)
       std::copy_n(before.bases.begin() + std::ptrdiff_t(ids[j] * n * d), n * d,
                   previous.begin() + std::ptrdiff_t(j * n * d));
     power.tolerance = o.refit_tolerance;
-    part_error = fit_cluster_pca_warm(x, part, previous, power);
+    grams->sync(data, next.cluster_of, next.cluster_count);
+    std::vector<const Eigen::MatrixXd*> part_grams(ids.size());
+    for (std::size_t j = 0; j < ids.size(); ++j) part_grams[j] = grams->gram(ids[j]);
+    part_error = fit_cluster_pca_warm(x, part, previous, power, part_grams);
   } else {
     part_error = fit_cluster_pca(x, part, o.solver, power);
   }
@@ -327,28 +331,28 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
   r.error.resize(r.offset.back());
   // Each cluster's candidate points in one matrix product (as subspace_distances does): one
   // (point, cluster) pair at a time cost half the search's time.
+  // The nearest means' distances are already in `near`, computed the same way.
   std::vector<std::vector<std::uint32_t>> entries(std::size_t(set.cluster_count));
   std::vector<std::uint32_t> point_of(r.offset.back());
   for (std::uint32_t p = 0; p < vertices; ++p)
     for (std::uint32_t i = 0; i < lists[p].size(); ++i) {
-      r.cluster[r.offset[p] + i] = lists[p][i];
-      point_of[r.offset[p] + i] = p;
-      entries[lists[p][i]].push_back(r.offset[p] + i);
+      const std::uint32_t c = lists[p][i], e = r.offset[p] + i;
+      r.cluster[e] = c;
+      point_of[e] = p;
+      if (const float known = near ? (*near)(Eigen::Index(p), Eigen::Index(c))
+                                   : std::numeric_limits<float>::infinity();
+          std::isfinite(known))
+        r.error[e] = double(known);
+      else
+        entries[c].push_back(e);
     }
-  const Eigen::Index d = data.cols();
   tbb::parallel_for(0, set.cluster_count, [&](int c) {
     const std::vector<std::uint32_t>& e = entries[std::size_t(c)];
     if (e.empty()) return;
-    const Eigen::Map<const Eigen::RowVectorXf> mean(
-        set.means.data() + std::size_t(c) * std::size_t(d), d);
-    DataMatrix centred(Eigen::Index(e.size()), d);
-    for (std::size_t i = 0; i < e.size(); ++i)
-      centred.row(Eigen::Index(i)) = data.row(point_of[e[i]]) - mean;
-    Eigen::VectorXf residual = centred.rowwise().squaredNorm();
-    if (set.component_count > 0)
-      residual -= (centred * set.basis(c).transpose()).rowwise().squaredNorm();
-    for (std::size_t i = 0; i < e.size(); ++i)
-      r.error[e[i]] = std::max(0.0, double(residual[Eigen::Index(i)]));
+    std::vector<std::uint32_t> points(e.size());
+    for (std::size_t i = 0; i < e.size(); ++i) points[i] = point_of[e[i]];
+    const std::vector<float> residual = subspace_residuals(data, set, c, points);
+    for (std::size_t i = 0; i < e.size(); ++i) r.error[e[i]] = double(residual[i]);
   });
   return r;
 }
@@ -421,7 +425,7 @@ bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
                   const VertexTriangles& vt, const Eigen::VectorXf& norms,
                   const JointSearchOptions& o, double mu, double cap_total, CompressedSet& set,
                   std::vector<double>& error, std::vector<std::uint32_t>& pass_of,
-                  JointSearchResult& r, bool& feasible) {
+                  ClusterGrams& grams, JointSearchResult& r, bool& feasible) {
   // Above the cap the search needs error-lowering moves, which the nearest means offer (as
   // in iterative CPCA); within it only moves that change draws matter, and those are bounded
   // to the 1-ring, so the V x K distance products are skipped.
@@ -438,7 +442,7 @@ bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
                size,        mu, r.triangles_drawn, std::numeric_limits<std::uint64_t>::max()};
   std::uint64_t drawn = r.triangles_drawn;
   drawn -= std::uint64_t(sweep_epsilon(cand, s, cap_total, moves));
-  std::vector<double> next_error = refit_changed(data, set, error, next, o, true);
+  std::vector<double> next_error = refit_changed(data, set, error, next, o, &grams);
   const ClusterIncidence inc = incidence_of(next, g, o.per_pass);
   PRTR_DCHECK(triangles_drawn(inc, next_pass) == drawn);
   drawn = swap_descent(inc, o.per_pass, next_pass, swaps);
@@ -576,13 +580,14 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
     const double cap_total = options.error_target * double(data.rows());
     double price = 2 * total / t;
     r.triangles_drawn = swap_descent(inc, options.per_pass, pass_of, r.pass_swaps);
+    ClusterGrams grams;
     for (int i = 1, rejected = 0; i <= options.max_steps && rejected < 3; ++i) {
       r.tried = i;
       bool feasible = false;
       const double error_before = total_of(vertex_error);
       const std::uint64_t drawn_before = r.triangles_drawn;
       const bool kept = epsilon_step(data, geometry, vt, norms, options, price, cap_total, set,
-                                     vertex_error, pass_of, r, feasible);
+                                     vertex_error, pass_of, grams, r, feasible);
       // A kept step that moved neither draws nor error by the threshold counts as a stall.
       const bool moved =
           kept && (double(drawn_before) - double(r.triangles_drawn) >=

@@ -5,6 +5,7 @@
 #include "splitmix.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
@@ -25,25 +26,15 @@ void check_k(const Eigen::Ref<const Eigen::MatrixXd>& f, int k) {
 
 using detail::next_uniform;
 
-}  // namespace
-
-PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
-                              const PowerIterationOptions& options) {
-  check_k(f, k);
+// Power iteration with deflation on A (lower triangle read and deflated), the smaller of F^T F
+// and F F^T.
+PcaResult iterate(const Eigen::Ref<const Eigen::MatrixXd>& f, Eigen::MatrixXd& a, int k,
+                  const PowerIterationOptions& options) {
   const Eigen::Index m = f.rows(), n = f.cols();
   PcaResult result;
   result.gram = m < n;
   result.basis = Eigen::MatrixXd::Zero(k, n);
   result.eigenvalues = Eigen::VectorXd::Zero(k);
-  // A is the smaller of F^T F (n x n) and F F^T (m x m); both share the non-zero spectrum.
-  // Only its lower triangle is formed and read: a rank update costs half the product, and
-  // the symmetric matrix-vector product reads A once for both triangles. On a cluster larger
-  // than the dimension these two are nearly all of the PCA's time.
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(std::min(m, n), std::min(m, n));
-  if (result.gram)
-    a.selfadjointView<Eigen::Lower>().rankUpdate(f);
-  else
-    a.selfadjointView<Eigen::Lower>().rankUpdate(f.transpose());
   const double scale = a.trace();
   if (!(scale > 0.0)) return result;  // all points equal the mean: nothing to find
   std::uint64_t state = options.seed;
@@ -91,6 +82,86 @@ PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
       result.eigenvalues[p] = 0.0;
       break;
     }
+    result.basis.row(p) = direction / norm;
+  }
+  return result;
+}
+
+}  // namespace
+
+PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& f, int k,
+                              const PowerIterationOptions& options) {
+  check_k(f, k);
+  const Eigen::Index m = f.rows(), n = f.cols();
+  // A is the smaller of F^T F (n x n) and F F^T (m x m); both share the non-zero spectrum.
+  // Only its lower triangle is formed and read: a rank update costs half the product, and
+  // the symmetric matrix-vector product reads A once for both triangles. On a cluster larger
+  // than the dimension these two are nearly all of the PCA's time.
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(std::min(m, n), std::min(m, n));
+  if (m < n)
+    a.selfadjointView<Eigen::Lower>().rankUpdate(f);
+  else
+    a.selfadjointView<Eigen::Lower>().rankUpdate(f.transpose());
+  return iterate(f, a, k, options);
+}
+
+PcaResult power_iteration_pca_gram(const Eigen::Ref<const Eigen::MatrixXd>& f, Eigen::MatrixXd gram,
+                                   int k, const PowerIterationOptions& options) {
+  check_k(f, k);
+  if (!(f.rows() < f.cols()) || gram.rows() != f.rows() || gram.cols() != f.rows())
+    throw std::invalid_argument("PCA: a Gram matrix needs fewer points than dimensions and " +
+                                std::to_string(f.rows()) + " x " + std::to_string(f.rows()) +
+                                " entries, got " + std::to_string(gram.rows()) + " x " +
+                                std::to_string(gram.cols()));
+  if (!options.start || options.start->rows() != k || options.start->cols() != f.cols())
+    return iterate(f, gram, k, options);
+  gram = gram.selfadjointView<Eigen::Lower>();  // the caller may have filled one triangle
+  const Eigen::Index m = f.rows(), n = f.cols();
+  PcaResult result;
+  result.gram = true;
+  result.basis = Eigen::MatrixXd::Zero(k, n);
+  result.eigenvalues = Eigen::VectorXd::Zero(k);
+  const double scale = gram.trace();
+  if (!(scale > 0.0)) return result;
+  // Simultaneous iteration (Rutishauser 1970) from the previous directions projected onto
+  // the points; a vanishing start column gets a seeded random one.
+  Eigen::MatrixXd q = f * options.start->transpose();
+  std::uint64_t state = options.seed;
+  for (int p = 0; p < k; ++p)
+    if (!(q.col(p).norm() > 1e-9 * std::sqrt(scale)))
+      for (Eigen::Index i = 0; i < m; ++i) q(i, p) = next_uniform(state) - 0.5;
+  const auto orthonormal = [k](const Eigen::MatrixXd& z) {
+    return Eigen::MatrixXd(Eigen::HouseholderQR<Eigen::MatrixXd>(z).householderQ() *
+                           Eigen::MatrixXd::Identity(z.rows(), k));
+  };
+  q = orthonormal(q);
+  Eigen::MatrixXd z = gram * q;
+  double energy = (q.transpose() * z).trace();
+  for (int it = 0; it < options.max_iterations; ++it) {
+    ++result.iterations;
+    q = orthonormal(z);
+    z.noalias() = gram * q;
+    const double next = (q.transpose() * z).trace();
+    const bool settled = !(next - energy > options.tolerance * next);
+    energy = next;
+    if (settled) break;
+  }
+  // Rayleigh-Ritz: the directions within the subspace, by decreasing eigenvalue.
+  Eigen::MatrixXd h = q.transpose() * z;
+  h = 0.5 * (h + h.transpose()).eval();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz(h);
+  if (ritz.info() != Eigen::Success) return iterate(f, gram, k, options);
+  for (int p = 0; p < k; ++p) {
+    const double lambda = ritz.eigenvalues()[k - 1 - p];
+    if (!(lambda > 1e-12 * scale)) break;
+    const Eigen::VectorXd u = q * ritz.eigenvectors().col(k - 1 - p);
+    Eigen::RowVectorXd direction = (f.transpose() * u).transpose();
+    for (int pass = 0; pass < 2; ++pass)
+      for (int r = 0; r < p; ++r)
+        direction -= direction.dot(result.basis.row(r)) * result.basis.row(r);
+    const double norm = direction.norm();
+    if (!(norm > 1e-6 * std::sqrt(lambda))) break;
+    result.eigenvalues[p] = lambda;
     result.basis.row(p) = direction / norm;
   }
   return result;

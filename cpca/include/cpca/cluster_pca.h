@@ -28,10 +28,14 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
 
 // The same, each cluster's power iteration started from `previous_bases` (K x N x D floats, as
 // CompressedSet::bases) of the same cluster id, with power.tolerance as given: a refit after a
-// search moved some points. Power-iteration solver only.
+// search moved some points. Power-iteration solver only. `grams`, when not empty, holds per
+// cluster either null or x_i . x_j (double) of its member rows in ascending order, which a
+// cluster with fewer members than dimensions then uses instead of forming F F^T
+// (cluster_gram.h keeps them up to date across a search).
 std::vector<double> fit_cluster_pca_warm(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                          const std::vector<float>& previous_bases,
-                                         const PowerIterationOptions& power);
+                                         const PowerIterationOptions& power,
+                                         const std::vector<const Eigen::MatrixXd*>& grams = {});
 
 // The same, out of core: each cluster gathers only its own rows (random access through
 // x.all()) and the source's pages are released after every cluster, so memory holds the
@@ -61,6 +65,12 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
 DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
                               const Eigen::VectorXf& x_squared_norms, const CompressedSet& set,
                               int candidates);
+
+// The same for rows `points` of x and one cluster, in float, clamped at 0: result[i] is
+// points[i]'s distance.
+std::vector<float> subspace_residuals(const Eigen::Ref<const DataMatrix>& x,
+                                      const CompressedSet& set, int cluster,
+                                      const std::vector<std::uint32_t>& points);
 
 // The same for one point and one cluster, in double.
 double subspace_distance(const Eigen::Ref<const Eigen::RowVectorXf>& x, const CompressedSet& set,

@@ -48,6 +48,17 @@ struct PcaResult {
 PcaResult power_iteration_pca(const Eigen::Ref<const Eigen::MatrixXd>& centred, int k,
                               const PowerIterationOptions& options = {});
 
+// The same from F F^T already formed (m x m, m < n; only the lower triangle is read), for a
+// caller that keeps it up to date as points join and leave a cluster: the PCA then costs
+// O(m n k) for the warm start and the directions instead of O(m^2 n) for the product. With a
+// full warm start (k rows) it iterates the whole k-dimensional subspace at once
+// (simultaneous iteration, Rutishauser 1970) until the captured energy trace(Q^T A Q) changes
+// by less than `tolerance` (relative), then orders the directions by Rayleigh-Ritz: a refit
+// needs the subspace, and per-direction convergence is slow when eigenvalues nearly tie.
+PcaResult power_iteration_pca_gram(const Eigen::Ref<const Eigen::MatrixXd>& centred,
+                                   Eigen::MatrixXd gram, int k,
+                                   const PowerIterationOptions& options = {});
+
 // The same result from Eigen's SelfAdjointEigenSolver (on the Gram matrix when m < n, as
 // above): the oracle for tests and the `--pca eigen` option. Directions past the data's rank
 // (eigenvalue below 1e-12 of the largest) are zero rows, as in power_iteration_pca.
