@@ -187,6 +187,44 @@ TEST(ClusterGrams, WarmRefitWithThemEqualsTheRefitWithout) {
   for (std::size_t p = 0; p < e0.size(); ++p) t0 += e0[p], t1 += e1[p];
   EXPECT_NEAR(t1, t0, 1e-6 * t0);
   EXPECT_EQ(with.means, without.means);
+
+  // Only some clusters, in place: those equal the full refit's, the others keep every number.
+  std::vector<char> only(clusters, 0);
+  only[1] = only[4] = 1;
+  cpca::CompressedSet part = set;
+  part.means.assign(with.means.size(), 7.f);
+  part.bases.assign(with.bases.size(), 7.f);
+  part.weights.assign(with.weights.size(), 7.f);
+  const std::vector<double> e2 = cpca::fit_cluster_pca_warm(x, part, previous, o, g, only);
+  const std::size_t d = dimension, n = 4;
+  for (int c = 0; c < clusters; ++c) {
+    const auto mean = [&](const cpca::CompressedSet& s) {
+      return std::vector<float>(s.means.begin() + std::ptrdiff_t(c * d),
+                                s.means.begin() + std::ptrdiff_t((c + 1) * d));
+    };
+    const auto basis = [&](const cpca::CompressedSet& s) {
+      return std::vector<float>(s.bases.begin() + std::ptrdiff_t(c * n * d),
+                                s.bases.begin() + std::ptrdiff_t((c + 1) * n * d));
+    };
+    if (only[std::size_t(c)]) {
+      EXPECT_EQ(mean(part), mean(with)) << c;
+      EXPECT_EQ(basis(part), basis(with)) << c;
+    } else {
+      EXPECT_EQ(mean(part), std::vector<float>(d, 7.f)) << c;
+      EXPECT_EQ(basis(part), std::vector<float>(n * d, 7.f)) << c;
+    }
+  }
+  for (int p = 0; p < points; ++p) {
+    const int c = int(set.cluster_of[std::size_t(p)]);
+    if (only[std::size_t(c)]) {
+      EXPECT_EQ(e2[std::size_t(p)], e1[std::size_t(p)]) << p;
+    } else {
+      EXPECT_EQ(e2[std::size_t(p)], 0.0) << p;
+      EXPECT_EQ(part.weights[std::size_t(p) * n], 7.f) << p;
+    }
+  }
+  std::vector<char> wrong(clusters - 1, 1);
+  EXPECT_THROW(cpca::fit_cluster_pca_warm(x, part, previous, o, g, wrong), std::invalid_argument);
 }
 
 }  // namespace

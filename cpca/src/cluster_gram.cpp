@@ -61,6 +61,16 @@ void ClusterGrams::sync(const Eigen::Ref<const DataMatrix>& data,
       Eigen::MatrixXd rows(m, data.cols());
       for (Eigen::Index i = 0; i < m; ++i)
         rows.row(i) = data.row(now[std::size_t(i)]).cast<double>();
+      computed += joined.size();
+      if (Eigen::Index(joined.size()) == m) {  // all new: the symmetric product costs half
+        g.setZero();
+        g.selfadjointView<Eigen::Lower>().rankUpdate(rows);
+        g = g.selfadjointView<Eigen::Lower>();
+        grams_[c] = std::move(g);
+        members_[c] = now;
+        kept_[c] = 1;
+        return;
+      }
       Eigen::MatrixXd fresh(Eigen::Index(joined.size()), data.cols());
       for (std::size_t a = 0; a < joined.size(); ++a)
         fresh.row(Eigen::Index(a)) = rows.row(joined[a]);
@@ -68,7 +78,6 @@ void ClusterGrams::sync(const Eigen::Ref<const DataMatrix>& data,
       for (std::size_t a = 0; a < joined.size(); ++a)
         for (Eigen::Index j = 0; j < m; ++j)
           g(joined[a], j) = g(j, joined[a]) = dots(Eigen::Index(a), j);
-      computed += joined.size();
     }
     grams_[c] = std::move(g);
     members_[c] = now;

@@ -36,14 +36,18 @@ std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolv
                                  const PowerIterationOptions& power, ClusterPcaStats* stats,
                                  const std::function<bool(int)>& fits = {},
                                  const std::vector<float>* warm = nullptr,
-                                 const std::vector<const Eigen::MatrixXd*>* grams = nullptr) {
+                                 const std::vector<const Eigen::MatrixXd*>* grams = nullptr,
+                                 bool keep_others = false) {
   const int k = set.cluster_count, n = set.component_count;
   const Eigen::Index d = x.cols();
   set.vertex_count = std::uint64_t(x.rows());
   set.solver = solver;
-  set.means.assign(std::size_t(k) * std::size_t(d), 0.f);
-  set.bases.assign(std::size_t(k) * std::size_t(n) * std::size_t(d), 0.f);
-  set.weights.assign(std::size_t(x.rows()) * std::size_t(n), 0.f);
+  // keep_others: the clusters `fits` skips keep their numbers (the arrays are full size).
+  if (!keep_others) {
+    set.means.assign(std::size_t(k) * std::size_t(d), 0.f);
+    set.bases.assign(std::size_t(k) * std::size_t(n) * std::size_t(d), 0.f);
+    set.weights.assign(std::size_t(x.rows()) * std::size_t(n), 0.f);
+  }
   std::vector<double> error(std::size_t(x.rows()), 0.0);
   const auto members = cluster_members(set.cluster_of, k);
   // Largest clusters first, so one big cluster does not finish alone at the end.
@@ -137,18 +141,29 @@ std::vector<double> fit_cluster_pca(const RowBlocks& x, CompressedSet& set, PcaS
 std::vector<double> fit_cluster_pca_warm(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                          const std::vector<float>& previous_bases,
                                          const PowerIterationOptions& power,
-                                         const std::vector<const Eigen::MatrixXd*>& grams) {
+                                         const std::vector<const Eigen::MatrixXd*>& grams,
+                                         const std::vector<char>& only) {
   if (!grams.empty() && grams.size() != std::size_t(set.cluster_count))
     throw std::invalid_argument("fit_cluster_pca_warm: " + std::to_string(grams.size()) +
                                 " Gram matrices for " + std::to_string(set.cluster_count) +
                                 " clusters");
+  const std::size_t d = std::size_t(x.cols()), n = std::size_t(set.component_count);
+  if (!only.empty() && (only.size() != std::size_t(set.cluster_count) ||
+                        set.means.size() != std::size_t(set.cluster_count) * d ||
+                        set.bases.size() != std::size_t(set.cluster_count) * n * d ||
+                        set.weights.size() != std::size_t(x.rows()) * n))
+    throw std::invalid_argument(
+        "fit_cluster_pca_warm: refitting some clusters needs one flag per cluster and the "
+        "set's means, bases and weights at full size");
   if (previous_bases.size() !=
       std::size_t(set.cluster_count) * std::size_t(set.component_count) * std::size_t(x.cols()))
     throw std::invalid_argument("fit_cluster_pca_warm: the previous bases hold " +
                                 std::to_string(previous_bases.size()) +
                                 " floats, not clusters x components x dimension");
-  return fit_clusters(RowBlocks(x), set, PcaSolver::kPowerIteration, power, nullptr, {},
-                      &previous_bases, grams.empty() ? nullptr : &grams);
+  std::function<bool(int)> fits;
+  if (!only.empty()) fits = [&only](int c) { return only[std::size_t(c)] != 0; };
+  return fit_clusters(RowBlocks(x), set, PcaSolver::kPowerIteration, power, nullptr, fits,
+                      &previous_bases, grams.empty() ? nullptr : &grams, !only.empty());
 }
 
 namespace {

@@ -153,10 +153,26 @@ std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
   for (std::size_t p = 0; p < next.cluster_of.size(); ++p)
     if (next.cluster_of[p] != before.cluster_of[p])
       changed[before.cluster_of[p]] = changed[next.cluster_of[p]] = 1;
+  std::vector<double> next_error = error;
+  PowerIterationOptions power;
+  power.seed = o.seed;
+  if (grams && o.solver == PcaSolver::kPowerIteration) {
+    // In place over all rows: the changed clusters' rows are not copied out, and the others
+    // keep their numbers.
+    if (std::find(changed.begin(), changed.end(), 1) == changed.end()) return next_error;
+    power.tolerance = o.refit_tolerance;
+    grams->sync(data, next.cluster_of, next.cluster_count);
+    std::vector<const Eigen::MatrixXd*> all(changed.size());
+    for (std::uint32_t c = 0; c < changed.size(); ++c) all[c] = grams->gram(c);
+    const std::vector<double> fitted =
+        fit_cluster_pca_warm(data, next, before.bases, power, all, changed);
+    for (std::size_t p = 0; p < next.cluster_of.size(); ++p)
+      if (changed[next.cluster_of[p]]) next_error[p] = fitted[p];
+    return next_error;
+  }
   std::vector<std::uint32_t> local(changed.size(), ~0u), ids;
   for (std::uint32_t c = 0; c < changed.size(); ++c)
     if (changed[c]) local[c] = std::uint32_t(ids.size()), ids.push_back(c);
-  std::vector<double> next_error = error;
   if (ids.empty()) return next_error;
   std::vector<std::uint32_t> rows;
   CompressedSet part;
@@ -167,23 +183,8 @@ std::vector<double> refit_changed(const Eigen::Ref<const DataMatrix>& data,
       rows.push_back(p), part.cluster_of.push_back(local[next.cluster_of[p]]);
   DataMatrix x(Eigen::Index(rows.size()), data.cols());
   for (std::size_t i = 0; i < rows.size(); ++i) x.row(Eigen::Index(i)) = data.row(rows[i]);
-  PowerIterationOptions power;
-  power.seed = o.seed;
   const std::size_t d = next.dimension(), n = std::size_t(next.component_count);
-  std::vector<double> part_error;
-  if (grams && o.solver == PcaSolver::kPowerIteration) {
-    std::vector<float> previous(ids.size() * n * d);
-    for (std::size_t j = 0; j < ids.size(); ++j)
-      std::copy_n(before.bases.begin() + std::ptrdiff_t(ids[j] * n * d), n * d,
-                  previous.begin() + std::ptrdiff_t(j * n * d));
-    power.tolerance = o.refit_tolerance;
-    grams->sync(data, next.cluster_of, next.cluster_count);
-    std::vector<const Eigen::MatrixXd*> part_grams(ids.size());
-    for (std::size_t j = 0; j < ids.size(); ++j) part_grams[j] = grams->gram(ids[j]);
-    part_error = fit_cluster_pca_warm(x, part, previous, power, part_grams);
-  } else {
-    part_error = fit_cluster_pca(x, part, o.solver, power);
-  }
+  const std::vector<double> part_error = fit_cluster_pca(x, part, o.solver, power);
   for (std::size_t j = 0; j < ids.size(); ++j) {
     std::copy_n(part.means.begin() + std::ptrdiff_t(j * d), d,
                 next.means.begin() + std::ptrdiff_t(ids[j] * d));

@@ -31,11 +31,14 @@ std::vector<double> fit_cluster_pca(const Eigen::Ref<const DataMatrix>& x, Compr
 // search moved some points. Power-iteration solver only. `grams`, when not empty, holds per
 // cluster either null or x_i . x_j (double) of its member rows in ascending order, which a
 // cluster with fewer members than dimensions then uses instead of forming F F^T
-// (cluster_gram.h keeps them up to date across a search).
+// (cluster_gram.h keeps them up to date across a search). `only`, when not empty, holds one
+// flag per cluster: only those are fitted, every other cluster keeps the mean, basis and
+// weights the set holds (full size), and their rows' errors are returned as 0.
 std::vector<double> fit_cluster_pca_warm(const Eigen::Ref<const DataMatrix>& x, CompressedSet& set,
                                          const std::vector<float>& previous_bases,
                                          const PowerIterationOptions& power,
-                                         const std::vector<const Eigen::MatrixXd*>& grams = {});
+                                         const std::vector<const Eigen::MatrixXd*>& grams = {},
+                                         const std::vector<char>& only = {});
 
 // The same, out of core: each cluster gathers only its own rows (random access through
 // x.all()) and the source's pages are released after every cluster, so memory holds the
