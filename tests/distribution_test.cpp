@@ -13,6 +13,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <thread>
 #include <utility>
@@ -91,16 +92,20 @@ class ThreadRank final : public cpca::Distribution {
 // f(distribution) on `ranks` threads; returns each rank's result.
 template <class F>
 auto run_ranks(int ranks, F f) {
+  using Result = decltype(f(std::declval<cpca::Distribution&>()));
   Mailboxes box;
-  std::vector<decltype(f(std::declval<cpca::Distribution&>()))> out(
-      static_cast<std::size_t>(ranks));
+  // One object per rank: a std::vector<bool> packs the ranks' results into shared words, so
+  // two threads writing theirs would race.
+  std::vector<std::optional<Result>> slots(static_cast<std::size_t>(ranks));
   std::vector<std::thread> threads;
   for (int r = 0; r < ranks; ++r)
     threads.emplace_back([&, r] {
       ThreadRank rank(r, ranks, box);
-      out[std::size_t(r)] = f(rank);
+      slots[std::size_t(r)] = f(rank);
     });
   for (auto& t : threads) t.join();
+  std::vector<Result> out;
+  for (auto& slot : slots) out.push_back(std::move(*slot));
   return out;
 }
 
