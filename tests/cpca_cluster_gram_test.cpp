@@ -6,6 +6,8 @@
 #include "cpca/lbg.h"
 #include "cpca/power_iteration.h"
 
+#include "cpca_test_support.h"
+
 #include <gtest/gtest.h>
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
@@ -16,20 +18,12 @@
 
 namespace {
 
-// m x n points with eigenvalues (of F F^T) `lambda` along random orthonormal directions,
-// centred.
+// m x n points with eigenvalues (of F F^T) near `lambda` along random orthonormal
+// directions, centred.
 Eigen::MatrixXd with_eigenvalues(int m, int n, const std::vector<double>& lambda, unsigned seed) {
-  std::srand(seed);
-  const int r = int(lambda.size());
-  const Eigen::MatrixXd u =
-      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(m, r)).householderQ() *
-      Eigen::MatrixXd::Identity(m, r);
-  const Eigen::MatrixXd v =
-      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(n, r)).householderQ() *
-      Eigen::MatrixXd::Identity(n, r);
-  Eigen::VectorXd s(r);
-  for (int i = 0; i < r; ++i) s[i] = std::sqrt(lambda[std::size_t(i)]);
-  Eigen::MatrixXd f = u * s.asDiagonal() * v.transpose();
+  Eigen::VectorXd s(Eigen::Index(lambda.size()));
+  for (std::size_t i = 0; i < lambda.size(); ++i) s[Eigen::Index(i)] = std::sqrt(lambda[i]);
+  Eigen::MatrixXd f = cpca_test::with_spectrum(m, n, s, seed);
   f.rowwise() -= f.colwise().mean();
   return f;
 }

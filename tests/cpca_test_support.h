@@ -1,7 +1,12 @@
-// tests/cpca_test_support.h: geometry shared by the cpca suites.
+// tests/cpca_test_support.h: geometry and data shared by the cpca suites.
 #pragma once
 
 #include "cpca/geometry.h"
+
+#include <Eigen/Core>
+#include <Eigen/QR>
+
+#include <cstdlib>
 
 namespace cpca_test {
 
@@ -19,6 +24,19 @@ inline cpca::Geometry grid(int n) {
       g.triangles.push_back({a, d, c});
     }
   return g;
+}
+
+// m x n data with singular values s (r = s.size()) along random orthonormal directions.
+inline Eigen::MatrixXd with_spectrum(int m, int n, const Eigen::VectorXd& s, unsigned seed) {
+  std::srand(seed);
+  const int r = int(s.size());
+  const Eigen::MatrixXd u =
+      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(m, r)).householderQ() *
+      Eigen::MatrixXd::Identity(m, r);
+  const Eigen::MatrixXd v =
+      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(n, r)).householderQ() *
+      Eigen::MatrixXd::Identity(n, r);
+  return u * s.asDiagonal() * v.transpose();
 }
 
 }  // namespace cpca_test

@@ -2,6 +2,8 @@
 // build), in both shapes: fewer points than dimensions (Gram path) and more.
 #include "cpca/power_iteration.h"
 
+#include "cpca_test_support.h"
+
 #include <gtest/gtest.h>
 #include <Eigen/QR>
 
@@ -10,18 +12,7 @@
 
 namespace {
 
-// m x n data with singular values s (r = s.size()) along random orthonormal directions.
-Eigen::MatrixXd with_spectrum(int m, int n, const Eigen::VectorXd& s, unsigned seed) {
-  std::srand(seed);
-  const int r = int(s.size());
-  const Eigen::MatrixXd u =
-      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(m, r)).householderQ() *
-      Eigen::MatrixXd::Identity(m, r);
-  const Eigen::MatrixXd v =
-      Eigen::HouseholderQR<Eigen::MatrixXd>(Eigen::MatrixXd::Random(n, r)).householderQ() *
-      Eigen::MatrixXd::Identity(n, r);
-  return u * s.asDiagonal() * v.transpose();
-}
+using cpca_test::with_spectrum;
 
 Eigen::VectorXd decaying(int r) {
   Eigen::VectorXd s(r);
