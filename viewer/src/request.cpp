@@ -251,8 +251,11 @@ ViewState parse_view_request(const QueryParams& params, const ViewLimits& limits
   std::set<std::string> seen;
   for (const auto& [name, value] : params) {
     const auto& table = setters();
+    // A named reference: clang 14 in C++17 (the fuzz build) cannot capture a structured
+    // binding.
+    const std::string& key = name;
     const auto it = std::find_if(table.begin(), table.end(),
-                                 [&](const auto& entry) { return entry.first == name; });
+                                 [&key](const auto& entry) { return entry.first == key; });
     if (it == table.end()) throw RequestError("unknown parameter " + quoted(name));
     if (!seen.insert(name).second) throw RequestError("parameter " + quoted(name) + " repeated");
     it->second(state, value, limits);
