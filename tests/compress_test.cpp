@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <Eigen/QR>
 
+#include <algorithm>
 #include <random>
 #include <set>
 
@@ -275,6 +276,35 @@ TEST(SubspaceDistances, CandidateRestrictionAgreesWithTheFullMatrix) {
     (means.rowwise() - x.row(p)).rowwise().squaredNorm().minCoeff(&nearest);
     EXPECT_TRUE(std::isfinite(some(p, int(nearest))));
   }
+}
+
+TEST(SubspaceDistances, ClusterClosureHoldsTheOwnClustersNearestMeans) {
+  const int k = 6;
+  const cpca::DataMatrix x = affine_subspaces(k, 30, 3, 16, 9);
+  const cpca::CompressedSet set = cpca::compress(x, order4_options(k, 2));
+  const cpca::DataMatrix full = cpca::subspace_distances(x, x.rowwise().squaredNorm(), set);
+  const cpca::DataMatrix near = cpca::subspace_distances_near_clusters(x, set, 3);
+  const cpca::DataMatrix means = Eigen::Map<const cpca::DataMatrix>(set.means.data(), k, 16);
+  for (int p = 0; p < x.rows(); ++p) {
+    const int own = int(set.cluster_of[std::size_t(p)]);
+    // The closure by brute force: the 3 means nearest the own cluster's mean (itself first).
+    std::vector<std::pair<float, int>> by_mean;
+    for (int c = 0; c < k; ++c)
+      by_mean.push_back({(means.row(c) - means.row(own)).squaredNorm(), c});
+    std::sort(by_mean.begin(), by_mean.end());
+    std::set<int> closure;
+    for (int i = 0; i < 3; ++i) closure.insert(by_mean[std::size_t(i)].second);
+    for (int c = 0; c < k; ++c) {
+      EXPECT_EQ(std::isfinite(near(p, c)), closure.count(c) == 1) << p << " " << c;
+      if (std::isfinite(near(p, c))) {
+        EXPECT_NEAR(near(p, c), full(p, c), 2e-6 * (x.row(p).squaredNorm() + full(p, c)));
+      }
+    }
+    EXPECT_TRUE(closure.count(own));
+  }
+  // More candidates than clusters: every column.
+  const cpca::DataMatrix all = cpca::subspace_distances_near_clusters(x, set, 100);
+  EXPECT_TRUE(all.allFinite());
 }
 
 }  // namespace

@@ -333,6 +333,41 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
   return out;
 }
 
+DataMatrix subspace_distances_near_clusters(const Eigen::Ref<const DataMatrix>& x,
+                                            const CompressedSet& set, int candidates) {
+  const int k = set.cluster_count;
+  const Eigen::Index d = x.cols();
+  const int nearest = std::clamp(candidates, 1, k);
+  const Eigen::Map<const DataMatrix> means(set.means.data(), k, d);
+  const DataMatrix between = squared_distances(means, means.rowwise().squaredNorm(), means);
+  // Each cluster's closure: itself and its nearest clusters by mean distance.
+  std::vector<std::vector<std::uint32_t>> closure(static_cast<std::size_t>(k));
+  tbb::parallel_for(0, k, [&](int c) {
+    std::vector<std::uint32_t> order(static_cast<std::size_t>(k));
+    std::iota(order.begin(), order.end(), 0u);
+    std::nth_element(order.begin(), order.begin() + (nearest - 1), order.end(),
+                     [&](std::uint32_t a, std::uint32_t b) {
+                       const float da = between(c, a), db = between(c, b);
+                       return da < db || (da == db && a < b);
+                     });
+    order.resize(std::size_t(nearest));
+    if (std::find(order.begin(), order.end(), std::uint32_t(c)) == order.end())
+      order.push_back(std::uint32_t(c));
+    closure[std::size_t(c)] = std::move(order);
+  });
+  std::vector<std::vector<std::uint32_t>> points(static_cast<std::size_t>(k));
+  for (std::uint32_t p = 0; p < set.cluster_of.size(); ++p)
+    for (std::uint32_t c : closure[set.cluster_of[p]]) points[c].push_back(p);
+  DataMatrix out = DataMatrix::Constant(x.rows(), k, std::numeric_limits<float>::infinity());
+  tbb::parallel_for(0, k, [&](int c) {
+    const std::vector<std::uint32_t>& members = points[std::size_t(c)];
+    const std::vector<float> residual = subspace_residuals(x, set, c, members);
+    // Columns of `out` are written by one task each: no two tasks touch the same entry.
+    for (std::size_t i = 0; i < members.size(); ++i) out(members[i], c) = residual[i];
+  });
+  return out;
+}
+
 std::vector<float> subspace_residuals(const Eigen::Ref<const DataMatrix>& x,
                                       const CompressedSet& set, int cluster,
                                       const std::vector<std::uint32_t>& points) {

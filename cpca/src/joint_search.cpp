@@ -423,15 +423,16 @@ std::int64_t sweep_epsilon(const Candidates& cand, SweepState& s, double cap,
 // when it lowers (violation of the error cap, triangles drawn, error) lexicographically.
 // Returns whether it was kept; `feasible` tells whether the proposal met the cap.
 bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
-                  const VertexTriangles& vt, const Eigen::VectorXf& norms,
-                  const JointSearchOptions& o, double mu, double cap_total, CompressedSet& set,
-                  std::vector<double>& error, std::vector<std::uint32_t>& pass_of,
-                  ClusterGrams& grams, JointSearchResult& r, bool& feasible) {
-  // Above the cap the search needs error-lowering moves, which the nearest means offer (as
-  // in iterative CPCA); within it only moves that change draws matter, and those are bounded
-  // to the 1-ring, so the V x K distance products are skipped.
+                  const VertexTriangles& vt, const JointSearchOptions& o, double mu,
+                  double cap_total, CompressedSet& set, std::vector<double>& error,
+                  std::vector<std::uint32_t>& pass_of, ClusterGrams& grams, JointSearchResult& r,
+                  bool& feasible) {
+  // Above the cap the search needs error-lowering moves, which the clusters near a vertex's
+  // own offer (its cluster's closure, cluster_pca.h); within it only moves that change draws
+  // matter, and those are bounded to the 1-ring, so no such distances are computed.
   const bool above = total_of(error) > cap_total;
-  const DataMatrix near = above ? subspace_distances(data, norms, set, o.candidates) : DataMatrix();
+  const DataMatrix near =
+      above ? subspace_distances_near_clusters(data, set, o.candidates) : DataMatrix();
   const Candidates cand = bounded_candidates(data, set, g, vt, pass_of, above ? &near : nullptr);
   CompressedSet next = set;
   std::vector<std::uint32_t> next_pass = pass_of;
@@ -587,7 +588,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
       bool feasible = false;
       const double error_before = total_of(vertex_error);
       const std::uint64_t drawn_before = r.triangles_drawn;
-      const bool kept = epsilon_step(data, geometry, vt, norms, options, price, cap_total, set,
+      const bool kept = epsilon_step(data, geometry, vt, options, price, cap_total, set,
                                      vertex_error, pass_of, grams, r, feasible);
       // A kept step that moved neither draws nor error by the threshold counts as a stall.
       const bool moved =

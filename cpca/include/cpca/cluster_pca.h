@@ -69,6 +69,14 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
                               const Eigen::VectorXf& x_squared_norms, const CompressedSet& set,
                               int candidates);
 
+// The same restricted to each point's own cluster and the `candidates` clusters whose means
+// are nearest its own cluster's mean (a cluster closure, after Wang et al. 2012, "Fast
+// approximate k-means via cluster closures"): one K x K distance product in place of the
+// V x K one above. A point's better cluster is nearly always one close to its own, and the
+// epsilon search takes these in every step that must lower the error.
+DataMatrix subspace_distances_near_clusters(const Eigen::Ref<const DataMatrix>& x,
+                                            const CompressedSet& set, int candidates);
+
 // The same for rows `points` of x and one cluster, in float, clamped at 0: result[i] is
 // points[i]'s distance.
 std::vector<float> subspace_residuals(const Eigen::Ref<const DataMatrix>& x,
