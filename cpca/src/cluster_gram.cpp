@@ -66,18 +66,15 @@ void ClusterGrams::sync(const Eigen::Ref<const DataMatrix>& data,
         g.setZero();
         g.selfadjointView<Eigen::Lower>().rankUpdate(rows);
         g = g.selfadjointView<Eigen::Lower>();
-        grams_[c] = std::move(g);
-        members_[c] = now;
-        kept_[c] = 1;
-        return;
+      } else {
+        Eigen::MatrixXd fresh(Eigen::Index(joined.size()), data.cols());
+        for (std::size_t a = 0; a < joined.size(); ++a)
+          fresh.row(Eigen::Index(a)) = rows.row(joined[a]);
+        const Eigen::MatrixXd dots = fresh * rows.transpose();  // joined x m
+        for (std::size_t a = 0; a < joined.size(); ++a)
+          for (Eigen::Index j = 0; j < m; ++j)
+            g(joined[a], j) = g(j, joined[a]) = dots(Eigen::Index(a), j);
       }
-      Eigen::MatrixXd fresh(Eigen::Index(joined.size()), data.cols());
-      for (std::size_t a = 0; a < joined.size(); ++a)
-        fresh.row(Eigen::Index(a)) = rows.row(joined[a]);
-      const Eigen::MatrixXd dots = fresh * rows.transpose();  // joined x m
-      for (std::size_t a = 0; a < joined.size(); ++a)
-        for (Eigen::Index j = 0; j < m; ++j)
-          g(joined[a], j) = g(j, joined[a]) = dots(Eigen::Index(a), j);
     }
     grams_[c] = std::move(g);
     members_[c] = now;

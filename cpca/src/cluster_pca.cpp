@@ -295,6 +295,41 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
   return out;
 }
 
+namespace {
+
+// The `count` ids in [0, k) of least distance(id), ties to the lower id, then `own` when it
+// is not among them.
+template <class Distance>
+std::vector<std::uint32_t> nearest_ids(int k, int count, std::uint32_t own, Distance distance) {
+  std::vector<std::uint32_t> order(static_cast<std::size_t>(k));
+  std::iota(order.begin(), order.end(), 0u);
+  std::nth_element(order.begin(), order.begin() + (count - 1), order.end(),
+                   [&](std::uint32_t a, std::uint32_t b) {
+                     const float da = distance(a), db = distance(b);
+                     return da < db || (da == db && a < b);
+                   });
+  order.resize(std::size_t(count));
+  if (std::find(order.begin(), order.end(), own) == order.end()) order.push_back(own);
+  return order;
+}
+
+// V x K, +infinity but for the points listed per cluster: column c holds points[c]'s squared
+// distances to cluster c's affine subspace.
+DataMatrix listed_distances(const Eigen::Ref<const DataMatrix>& x, const CompressedSet& set,
+                            const std::vector<std::vector<std::uint32_t>>& points) {
+  DataMatrix out =
+      DataMatrix::Constant(x.rows(), set.cluster_count, std::numeric_limits<float>::infinity());
+  tbb::parallel_for(0, set.cluster_count, [&](int c) {
+    const std::vector<std::uint32_t>& members = points[std::size_t(c)];
+    const std::vector<float> residual = subspace_residuals(x, set, c, members);
+    // Columns of `out` are written by one task each: no two tasks touch the same entry.
+    for (std::size_t i = 0; i < members.size(); ++i) out(members[i], c) = residual[i];
+  });
+  return out;
+}
+
+}  // namespace
+
 DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
                               const Eigen::VectorXf& x_squared_norms, const CompressedSet& set,
                               int candidates) {
@@ -303,69 +338,32 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
   const Eigen::Index v = x.rows(), d = x.cols();
   const Eigen::Map<const DataMatrix> means(set.means.data(), k, d);
   const DataMatrix to_means = squared_distances(x, x_squared_norms, means);
-  // Candidate lists per cluster.
-  std::vector<std::vector<std::uint32_t>> points(static_cast<std::size_t>(k));
-  {
-    std::vector<std::vector<std::uint32_t>> chosen(static_cast<std::size_t>(v));
-    tbb::parallel_for(Eigen::Index(0), v, [&](Eigen::Index p) {
-      std::vector<std::uint32_t> order(static_cast<std::size_t>(k));
-      std::iota(order.begin(), order.end(), 0u);
-      std::nth_element(order.begin(), order.begin() + candidates, order.end(),
-                       [&](std::uint32_t a, std::uint32_t b) {
-                         const float da = to_means(p, a), db = to_means(p, b);
-                         return da < db || (da == db && a < b);
-                       });
-      order.resize(std::size_t(candidates));
-      const std::uint32_t current = set.cluster_of[std::size_t(p)];
-      if (std::find(order.begin(), order.end(), current) == order.end()) order.push_back(current);
-      chosen[std::size_t(p)] = std::move(order);
-    });
-    for (Eigen::Index p = 0; p < v; ++p)
-      for (std::uint32_t j : chosen[std::size_t(p)]) points[j].push_back(std::uint32_t(p));
-  }
-  DataMatrix out = DataMatrix::Constant(v, k, std::numeric_limits<float>::infinity());
-  tbb::parallel_for(0, k, [&](int j) {
-    const auto& members = points[std::size_t(j)];
-    const std::vector<float> residual = subspace_residuals(x, set, j, members);
-    // Columns of `out` are written by one task each: no two tasks touch the same entry.
-    for (std::size_t i = 0; i < members.size(); ++i) out(members[i], j) = residual[i];
+  std::vector<std::vector<std::uint32_t>> chosen(static_cast<std::size_t>(v));
+  tbb::parallel_for(Eigen::Index(0), v, [&](Eigen::Index p) {
+    chosen[std::size_t(p)] = nearest_ids(k, candidates, set.cluster_of[std::size_t(p)],
+                                         [&](std::uint32_t c) { return to_means(p, c); });
   });
-  return out;
+  std::vector<std::vector<std::uint32_t>> points(static_cast<std::size_t>(k));
+  for (Eigen::Index p = 0; p < v; ++p)
+    for (std::uint32_t j : chosen[std::size_t(p)]) points[j].push_back(std::uint32_t(p));
+  return listed_distances(x, set, points);
 }
 
 DataMatrix subspace_distances_near_clusters(const Eigen::Ref<const DataMatrix>& x,
                                             const CompressedSet& set, int candidates) {
   const int k = set.cluster_count;
-  const Eigen::Index d = x.cols();
-  const int nearest = std::clamp(candidates, 1, k);
-  const Eigen::Map<const DataMatrix> means(set.means.data(), k, d);
+  const Eigen::Map<const DataMatrix> means(set.means.data(), k, x.cols());
   const DataMatrix between = squared_distances(means, means.rowwise().squaredNorm(), means);
   // Each cluster's closure: itself and its nearest clusters by mean distance.
   std::vector<std::vector<std::uint32_t>> closure(static_cast<std::size_t>(k));
   tbb::parallel_for(0, k, [&](int c) {
-    std::vector<std::uint32_t> order(static_cast<std::size_t>(k));
-    std::iota(order.begin(), order.end(), 0u);
-    std::nth_element(order.begin(), order.begin() + (nearest - 1), order.end(),
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       const float da = between(c, a), db = between(c, b);
-                       return da < db || (da == db && a < b);
-                     });
-    order.resize(std::size_t(nearest));
-    if (std::find(order.begin(), order.end(), std::uint32_t(c)) == order.end())
-      order.push_back(std::uint32_t(c));
-    closure[std::size_t(c)] = std::move(order);
+    closure[std::size_t(c)] = nearest_ids(k, std::clamp(candidates, 1, k), std::uint32_t(c),
+                                          [&](std::uint32_t b) { return between(c, b); });
   });
   std::vector<std::vector<std::uint32_t>> points(static_cast<std::size_t>(k));
   for (std::uint32_t p = 0; p < set.cluster_of.size(); ++p)
     for (std::uint32_t c : closure[set.cluster_of[p]]) points[c].push_back(p);
-  DataMatrix out = DataMatrix::Constant(x.rows(), k, std::numeric_limits<float>::infinity());
-  tbb::parallel_for(0, k, [&](int c) {
-    const std::vector<std::uint32_t>& members = points[std::size_t(c)];
-    const std::vector<float> residual = subspace_residuals(x, set, c, members);
-    // Columns of `out` are written by one task each: no two tasks touch the same entry.
-    for (std::size_t i = 0; i < members.size(); ++i) out(members[i], c) = residual[i];
-  });
-  return out;
+  return listed_distances(x, set, points);
 }
 
 std::vector<float> subspace_residuals(const Eigen::Ref<const DataMatrix>& x,

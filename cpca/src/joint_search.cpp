@@ -289,7 +289,7 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
 // The epsilon search's candidates: for every vertex its own cluster (first), the other
 // clusters of its pass (a move among them costs no draws), the clusters of its 1-ring (the
 // only moves that can change draws) and, when `near` is given, the finite entries of its row
-// (the nearest means), each with its squared distance to that cluster's affine subspace under
+// (its cluster's closure), each with its squared distance to that cluster's affine subspace under
 // the step's bases. Without `near` a step costs O(V (per_pass + ring)) distances instead of
 // iterative CPCA's V x K mean products.
 struct Candidates {
@@ -332,7 +332,7 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
   r.error.resize(r.offset.back());
   // Each cluster's candidate points in one matrix product (as subspace_distances does): one
   // (point, cluster) pair at a time cost half the search's time.
-  // The nearest means' distances are already in `near`, computed the same way.
+  // The closure's distances are already in `near`, computed the same way.
   std::vector<std::vector<std::uint32_t>> entries(std::size_t(set.cluster_count));
   std::vector<std::uint32_t> point_of(r.offset.back());
   for (std::uint32_t p = 0; p < vertices; ++p)

@@ -227,6 +227,11 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   return s;
 }
 
+// Unset, the context decides: deferred on a software rasterizer (render/slf_renderer.h).
+bool resolve_deferred(const SlfRendererOptions& options) {
+  return options.deferred.value_or(current_gl_info().software_rasterizer());
+}
+
 void texture_parameters(GLenum target, GLint filter) {
   glTexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
   glTexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
@@ -263,7 +268,7 @@ struct SlfRenderer::Impl {
 SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
                         const SlfRendererOptions& renderer_options)
     : options(renderer_options),
-      deferred(renderer_options.deferred.value_or(current_gl_info().software_rasterizer())),
+      deferred(slf_gl::resolve_deferred(renderer_options)),
       background_pass(probe) {
   model.validate();
   shape.map_width = model.map_width;
@@ -514,7 +519,7 @@ void SlfRenderer::set_probe(const probes::Probe* probe) {
 }
 
 void SlfRenderer::set_options(const SlfRendererOptions& options) {
-  const bool deferred = options.deferred.value_or(current_gl_info().software_rasterizer());
+  const bool deferred = slf_gl::resolve_deferred(options);
   const bool rebuild =
       options.shared_cluster_fast_path != impl_->options.shared_cluster_fast_path ||
       deferred != impl_->deferred;
