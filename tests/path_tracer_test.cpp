@@ -106,42 +106,137 @@ TEST(PathTracer, SharpCookTorranceLobeReflectsTheProbe) {
   expect_mirror(m);
 }
 
-TEST(PathTracer, MisEstimateMatchesADenseQuadrature) {
-  const meshes::Mesh plane = meshes::make_plane(4.f, 2);
-  // A bright, smooth lobe of light plus a dim sky: light sampling matters.
-  const Eigen::Vector3d sun = Eigen::Vector3d(0.4, 0.8, -0.3).normalized();
-  const probes::Probe probe = probes::make_from_function(128, 64, [&](const Eigen::Vector3d& d) {
+// A plane lit by a bright, smooth lobe of light plus a dim sky (light sampling matters), a
+// point on it and a view, and the integral the estimators target, int f(v, s) s.z L(s) ds
+// over the upper hemisphere, by a dense midpoint rule in (cos theta, phi) in the point's own
+// frame: no importance sampling, no random numbers.
+struct QuadratureCase {
+  meshes::Mesh plane = meshes::make_plane(4.f, 2);
+  Eigen::Vector3d sun = Eigen::Vector3d(0.4, 0.8, -0.3).normalized();
+  probes::Probe probe = probes::make_from_function(128, 64, [this](const Eigen::Vector3d& d) {
     const double lobe = std::exp(40.0 * (d.dot(sun) - 1.0));
     return probes::Rgb(float(0.2 + 8 * lobe), float(0.1 + 6 * lobe), float(0.3 + 4 * lobe));
   });
+  Eigen::Vector3d view = Eigen::Vector3d(-0.5, 0.7, 0.4).normalized();
+
+  Eigen::Vector3d expected(const prt::Material& m, const prt::SurfacePoint& p) const {
+    const Eigen::Vector3d v = p.frame.transpose() * view;
+    constexpr int kTheta = 300, kPhi = 600;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int i = 0; i < kTheta; ++i) {
+      const double z = (i + 0.5) / kTheta, r = std::sqrt(1 - z * z);
+      for (int j = 0; j < kPhi; ++j) {
+        const double phi = 2 * kPi * (j + 0.5) / kPhi;
+        const Eigen::Vector3d s(r * std::cos(phi), r * std::sin(phi), z);
+        const Eigen::Vector3d le = probe.lookup(p.frame * s).cast<double>();
+        for (int c = 0; c < 3; ++c) sum[c] += prt::brdf_eval(m, c, v, s) * z * le[c];
+      }
+    }
+    return sum * (1.0 / kTheta) * (2 * kPi / kPhi);
+  }
+};
+
+prt::Material glossy_phong() {
   prt::Material m;
   m.kind = prt::MaterialKind::kPhong;
   m.albedo = Eigen::Vector3f(0.3f, 0.4f, 0.5f);
   m.specular = 0.4f;
   m.exponent = 30.f;
+  return m;
+}
+
+prt::Material glossy_cook_torrance() {
+  prt::Material m;
+  m.kind = prt::MaterialKind::kCookTorrance;
+  m.albedo = Eigen::Vector3f(0.3f, 0.4f, 0.5f);
+  m.specular = 0.5f;
+  m.roughness = 0.15f;
+  return m;
+}
+
+TEST(PathTracer, MisEstimateMatchesADenseQuadrature) {
+  const QuadratureCase q;
+  const prt::Material m = glossy_phong();
   prt::PathTracerOptions options;
   options.bounces = 0;
-  const prt::PathTracer tracer(plane, probe, m, options);
+  const prt::PathTracer tracer(q.plane, q.probe, m, options);
   const prt::SurfacePoint p = centroid(tracer, 1);
-  const Eigen::Vector3d view = Eigen::Vector3d(-0.5, 0.7, 0.4).normalized();
-  const Eigen::Vector3d v = p.frame.transpose() * view;
-  // The integral the estimator targets, int f(v, s) s.z L(s) ds over the upper hemisphere,
-  // by a dense midpoint rule in (cos theta, phi) in the point's own frame: no importance
-  // sampling, no random numbers.
-  constexpr int kTheta = 300, kPhi = 600;
-  Eigen::Vector3d expected = Eigen::Vector3d::Zero();
-  for (int i = 0; i < kTheta; ++i) {
-    const double z = (i + 0.5) / kTheta, r = std::sqrt(1 - z * z);
-    for (int j = 0; j < kPhi; ++j) {
-      const double phi = 2 * kPi * (j + 0.5) / kPhi;
-      const Eigen::Vector3d s(r * std::cos(phi), r * std::sin(phi), z);
-      const Eigen::Vector3d le = probe.lookup(p.frame * s).cast<double>();
-      for (int c = 0; c < 3; ++c) expected[c] += prt::brdf_eval(m, c, v, s) * z * le[c];
+  const Eigen::Vector3d expected = q.expected(m, p);
+  const Eigen::Vector3d l = tracer.exit_radiance(p, q.view, 8192, 5);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(l[c], expected[c], 0.015 * expected[c]) << c;
+}
+
+// The surface light field's estimator: the light technique from samples shared by many
+// views (shared_light_sum) and the paths' BRDF technique weighted for them (ExitQuery's
+// shared_light_ratio) together estimate the same integral, for several sharing ratios.
+TEST(PathTracer, SharedLightSamplesMatchADenseQuadrature) {
+  const QuadratureCase q;
+  for (const prt::Material& m : {glossy_phong(), glossy_cook_torrance()}) {
+    prt::PathTracerOptions options;
+    options.bounces = 0;
+    const prt::PathTracer tracer(q.plane, q.probe, m, options);
+    const prt::SurfacePoint p = centroid(tracer, 1);
+    const Eigen::Vector3d expected = q.expected(m, p);
+    constexpr int kPaths = 4096;
+    for (int ratio : {1, 4}) {
+      const prt::SharedLights lights = tracer.sample_lights(p, kPaths * ratio, 77);
+      ASSERT_EQ(lights.size(), std::size_t(kPaths * ratio));
+      const std::vector<Eigen::Vector3d> views(lights.size(), q.view);
+      std::vector<std::uint32_t> lights_of(lights.size());
+      for (std::size_t i = 0; i < lights.size(); ++i)
+        lights_of[i] = std::uint32_t((i + 3) % lights.size());
+      const Eigen::Vector3d light_part =
+          tracer.shared_light_sum(p, lights, views, lights_of, double(ratio)) /
+          double(lights.size());
+      std::vector<prt::ExitQuery> queries;
+      for (int k = 0; k < kPaths; ++k) {
+        prt::ExitQuery e{p, q.view, std::uint64_t(k), 0};
+        e.shared_light_ratio = ratio;
+        queries.push_back(e);
+      }
+      Eigen::Vector3d brdf_part = Eigen::Vector3d::Zero();
+      tracer.add_exit_radiance(queries, &brdf_part);
+      const Eigen::Vector3d l = light_part + brdf_part / kPaths;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(l[c], expected[c], 0.02 * expected[c]) << int(m.kind) << " " << ratio << c;
+      // Each technique alone is biased (each covers only its share of the weights).
+      EXPECT_GT(light_part.minCoeff(), 0.0);
+      EXPECT_GT(brdf_part.minCoeff(), 0.0);
     }
   }
-  expected *= (1.0 / kTheta) * (2 * kPi / kPhi);
-  const Eigen::Vector3d l = tracer.exit_radiance(p, view, 8192, 5);
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(l[c], expected[c], 0.015 * expected[c]) << c;
+}
+
+TEST(PathTracer, SharedLightSamplesAreShadowed) {
+  // A point under a much larger plane (its back face toward the point): every direction
+  // more than a few degrees above the horizon is blocked, the ones below are never lit.
+  meshes::Mesh two =
+      meshes::merge({meshes::make_plane(4.f, 2, 0.f), meshes::make_plane(40.f, 2, 1.f)});
+  meshes::compute_frames(two);
+  const probes::Probe sky = probes::make_constant(64, 32, probes::Rgb(1, 1, 1));
+  const prt::PathTracer covered(two, sky, glossy_phong());
+  const prt::SurfacePoint p = centroid(covered, 1);
+  const prt::SharedLights lights = covered.sample_lights(p, 256, 9);
+  ASSERT_EQ(lights.size(), 256u);
+  int lit = 0;
+  for (std::size_t j = 0; j < lights.size(); ++j) {
+    EXPECT_GT(lights.pdf[j], 0.0);
+    if (lights.direction[j].z() > 0.1 || lights.direction[j].z() <= 0) {
+      EXPECT_EQ(lights.radiance[j].maxCoeff(), 0.0) << j;
+    }
+    lit += lights.radiance[j].maxCoeff() > 0 ? 1 : 0;
+  }
+  EXPECT_LT(lit, 16);
+  // Without the upper plane every sample above the horizon sees the sky, about half.
+  const meshes::Mesh one = meshes::make_plane(4.f, 2, 0.f);
+  const prt::PathTracer open(one, sky, glossy_phong());
+  const prt::SharedLights seen = open.sample_lights(centroid(open, 1), 256, 9);
+  int above = 0;
+  for (std::size_t j = 0; j < seen.size(); ++j) {
+    const bool up = seen.direction[j].z() > 0;
+    above += up ? 1 : 0;
+    EXPECT_EQ(seen.radiance[j].maxCoeff(), up ? 1.0 : 0.0) << j;
+  }
+  EXPECT_NEAR(above, 128, 24);
 }
 
 TEST(ProbeSampler, DensityMatchesItsSamplesAndIntegratesTheProbe) {

@@ -1,8 +1,10 @@
 // Tests for prt/slf_bake.h: a Lambert sphere under a white sky gives a constant matrix (the
-// albedo, every texel and direction, silhouette views included), the streamed file holds the
-// in-memory bake, row ranges baked apart join to the whole bake's bytes, the file records how
-// the atlas was cut (a version 1 file, from before conformal charts, reads as per-triangle),
-// and damaged files are refused with messages naming the file.
+// albedo, every texel and direction, silhouette views included), with or without shared
+// light samples; the shared-light estimator agrees with the paths' own; the streamed file
+// holds the in-memory bake, row ranges baked apart join to the whole bake's bytes, the file
+// records how the atlas was cut and the light samples (a version 1 file, from before
+// conformal charts, reads as per-triangle; versions 1 and 2 as no light samples), and damaged
+// files are refused with messages naming the file.
 #include "prt/slf_bake.h"
 #include "common/hash.h"
 #include "meshes/atlas.h"
@@ -13,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -61,17 +64,70 @@ prt::SlfBakeOptions lambert_options(int spp) {
 
 TEST(SlfBake, LambertSphereUnderWhiteSkyIsConstant) {
   const Scene s;
-  const prt::SlfMatrix m = prt::bake_slf(s.mesh, s.atlas, s.sky, lambert_options(128));
-  ASSERT_EQ(m.shape.rows, s.atlas.used_texels());
-  ASSERT_EQ(m.shape.row_count, m.shape.rows);
-  ASSERT_EQ(m.shape.columns(), std::size_t(3 * 8 * 4));
-  ASSERT_EQ(m.data.size(), m.shape.rows * m.shape.columns());
-  double sum = 0;
-  for (float v : m.data) {
-    EXPECT_NEAR(v, 0.6, 0.12);
-    sum += v;
+  for (int light_samples : {0, 8}) {
+    prt::SlfBakeOptions o = lambert_options(128);
+    o.light_samples = light_samples;
+    const prt::SlfMatrix m = prt::bake_slf(s.mesh, s.atlas, s.sky, o);
+    ASSERT_EQ(m.shape.rows, s.atlas.used_texels());
+    ASSERT_EQ(m.shape.row_count, m.shape.rows);
+    ASSERT_EQ(m.shape.columns(), std::size_t(3 * 8 * 4));
+    ASSERT_EQ(m.data.size(), m.shape.rows * m.shape.columns());
+    double sum = 0;
+    for (float v : m.data) {
+      EXPECT_NEAR(v, 0.6, 0.12) << light_samples;
+      sum += v;
+    }
+    EXPECT_NEAR(sum / double(m.data.size()), 0.6, 0.006) << light_samples;
   }
-  EXPECT_NEAR(sum / double(m.data.size()), 0.6, 0.006);
+}
+
+// The shared-light estimator against the paths' own (a second code path through the same
+// integral): a glossy sphere under a sun and a sky, two bakes with each. The mean radiance of
+// each row of cells (polar band) over all texels agrees, and the squared difference between
+// the estimators is what their noises (each from its own two bakes) make, with no room for
+// a per-cell bias: a missing or doubled MIS weight shows in both.
+TEST(SlfBake, SharedLightSamplesAgreeWithThePathsOwn) {
+  const Scene s;
+  const Eigen::Vector3d sun_direction = Eigen::Vector3d(0.3, 0.8, 0.5).normalized();
+  const probes::Probe sun = probes::make_from_function(64, 32, [&](const Eigen::Vector3d& d) {
+    const double disc = d.dot(sun_direction) > std::cos(0.2) ? 1.0 : 0.0;
+    return probes::Rgb(float(0.3 + 20 * disc), float(0.4 + 18 * disc), float(0.6 + 15 * disc));
+  });
+  prt::SlfBakeOptions o;
+  o.grid = {8, 4};
+  o.material.kind = prt::MaterialKind::kCookTorrance;
+  o.material.roughness = 0.2f;
+  o.material.specular = 0.5f;
+  o.material.albedo = Eigen::Vector3f::Constant(0.3f);
+  o.spp = 64;
+  std::vector<prt::SlfMatrix> own, shared;
+  // Four seeds: bakes with one seed share their paths' numbers, so their noises correlate.
+  for (std::uint64_t seed : {1, 2}) {
+    o.seed = seed;
+    o.light_samples = 0;
+    own.push_back(prt::bake_slf(s.mesh, s.atlas, sun, o));
+    o.seed = seed + 2;
+    o.light_samples = 4;
+    shared.push_back(prt::bake_slf(s.mesh, s.atlas, sun, o));
+  }
+  const std::size_t columns = own[0].shape.columns();
+  std::vector<double> band_own(4, 0.0), band_shared(4, 0.0);
+  double between = 0, own_twice = 0, shared_twice = 0;
+  for (std::size_t i = 0; i < own[0].data.size(); ++i) {
+    const std::size_t band = (i % columns) / 3 / 8;
+    band_own[band] += own[0].data[i] + own[1].data[i];
+    band_shared[band] += shared[0].data[i] + shared[1].data[i];
+    between += std::pow(double(own[0].data[i]) - shared[0].data[i], 2);
+    own_twice += std::pow(double(own[0].data[i]) - own[1].data[i], 2);
+    shared_twice += std::pow(double(shared[0].data[i]) - shared[1].data[i], 2);
+  }
+  for (int band = 0; band < 4; ++band) {
+    EXPECT_GT(band_shared[band], 0.0);
+    EXPECT_NEAR(band_shared[band] / band_own[band], 1.0, 0.03) << band;
+  }
+  // E[between] = var_own + var_shared = (own_twice + shared_twice) / 2, plus any bias^2.
+  const double noise = (own_twice + shared_twice) / 2;
+  EXPECT_NEAR(between / noise, 1.0, 0.25);
 }
 
 TEST(SlfBake, FileHoldsTheBakeAndPartsJoinToIt) {
@@ -136,16 +192,22 @@ std::string as_version(std::string bytes, std::uint32_t version, std::uint16_t c
   return bytes;
 }
 
-TEST(SlfBake, TheFileRecordsTheChartsAndVersion1ReadsAsPerTriangle) {
+TEST(SlfBake, TheFileRecordsTheChartsAndLightSamplesAndOlderVersionsRead) {
   const Scene s;
   const meshes::Atlas per_triangle =
       meshes::make_atlas(s.mesh, 24, 24, {meshes::AtlasCharts::kPerTriangle});
   ASSERT_EQ(s.atlas.charts, meshes::AtlasCharts::kConformal);
   const fs::path conformal_path = scratch("slf_bake", "conformal.slf");
-  prt::bake_slf_to_file(s.mesh, s.atlas, s.sky, lambert_options(1), conformal_path);
+  prt::SlfBakeOptions o = lambert_options(1);
+  o.light_samples = 5;
+  prt::bake_slf_to_file(s.mesh, s.atlas, s.sky, o, conformal_path);
   EXPECT_EQ(prt::read_slf(conformal_path).shape.charts, meshes::AtlasCharts::kConformal);
+  EXPECT_EQ(prt::read_slf(conformal_path).shape.light_samples, 5);
+  EXPECT_EQ(prt::read_slf(conformal_path).shape.bounces, 1);
+  // Versions 1 and 2 knew no shared light samples (their u32 bounces had zero high bytes).
   const fs::path path = scratch("slf_bake", "per_triangle.slf");
-  prt::bake_slf_to_file(s.mesh, per_triangle, s.sky, lambert_options(1), path);
+  o.light_samples = 0;
+  prt::bake_slf_to_file(s.mesh, per_triangle, s.sky, o, path);
   const prt::SlfMatrix v2 = prt::read_slf(path);
   EXPECT_EQ(v2.shape.charts, meshes::AtlasCharts::kPerTriangle);
   EXPECT_EQ(v2.shape.rows, per_triangle.used_texels());
@@ -161,15 +223,19 @@ TEST(SlfBake, TheFileRecordsTheChartsAndVersion1ReadsAsPerTriangle) {
   test_support::error_of<prt::SlfFileError>(
       test_support::write_scratch("slf_bake", "v1wide.slf", as_version(bytes, 1, 1)), read,
       "atlas size");
+  EXPECT_EQ(
+      prt::read_slf(test_support::write_scratch("slf_bake", "v2.slf", as_version(bytes, 2, 1)))
+          .shape.light_samples,
+      0);
   test_support::error_of<prt::SlfFileError>(
       test_support::write_scratch("slf_bake", "charts.slf", as_version(bytes, 2, 7)), read,
       "atlas chart method 7 is unknown");
   test_support::error_of<prt::SlfFileError>(
-      test_support::write_scratch("slf_bake", "v3.slf", as_version(bytes, 3, 0)), read,
+      test_support::write_scratch("slf_bake", "v4.slf", as_version(bytes, 4, 0)), read,
       "newer prtr version");
   test_support::error_of<prt::SlfFileError>(
       test_support::write_scratch("slf_bake", "v0.slf", as_version(bytes, 0, 0)), read,
-      "reads versions 1 to 2");
+      "reads versions 1 to 3");
 }
 
 TEST(SlfBake, DamagedFilesAreRefusedNamingTheFile) {

@@ -164,18 +164,23 @@ TEST(SlfPipeline, BadSettingsAndDamagedFilesAreRefused) {
                                                   read, "truncated header");
   test_support::error_of<pipeline::SlfcFileError>(scratch("slf_pipeline", "none.slfc"), read,
                                                   "create it with prtr slf");
-  // A version 1 file (u32 width at 16, so no charts field; the checksum recomputed) reads
-  // as per-triangle charts, which were all version 1 had.
+  // A version 1 file (u32 width at 16, so no charts field; u32 bounces at 36, so no light
+  // samples; the checksum recomputed) reads as per-triangle charts and no shared light
+  // samples, which were all version 1 had.
   ASSERT_EQ(run.slf.bake.charts, meshes::AtlasCharts::kConformal);
+  EXPECT_EQ(pipeline::read_slfc(good).bake.light_samples, prt::SlfBakeOptions{}.light_samples);
   std::string old = bytes;
   const std::uint32_t version = 1;
   std::memcpy(old.data() + 8, &version, 4);
   old[18] = old[19] = 0;
+  old[38] = old[39] = 0;
   const std::uint64_t sum = common::fnv1a(old.data(), 120);
   std::memcpy(old.data() + 120, &sum, 8);
   const pipeline::CompressedSlf v1 = pipeline::read_slfc(damaged("v1.slfc", old));
   EXPECT_EQ(v1.bake.charts, meshes::AtlasCharts::kPerTriangle);
   EXPECT_EQ(v1.bake.atlas_width, 24);
+  EXPECT_EQ(v1.bake.light_samples, 0);
+  EXPECT_EQ(v1.bake.bounces, run.slf.bake.bounces);
   EXPECT_EQ(v1.set.weights, run.slf.set.weights);
   std::string unknown = bytes;
   unknown[18] = 9;

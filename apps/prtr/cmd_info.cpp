@@ -256,6 +256,7 @@ void slf_shape_json(Json& j, const prt::SlfShape& b) {
   j["rows_stored"] = b.row_count;
   j["spp"] = b.spp;
   j["bounces"] = b.bounces;
+  j["light_samples"] = b.light_samples;
   j["bake_seed"] = b.seed;
   j["material"] = material_json(b.material);
   j["mesh_hash"] = hex16(b.mesh_hash);
@@ -273,8 +274,10 @@ void print_slf_shape(const prt::SlfShape& b) {
   else
     std::printf("rows        %llu to %llu of %llu (a part)\n", u(b.first_row),
                 u(b.first_row + b.row_count), u(b.rows));
-  std::printf("bake        %d spp, %d bounce(s), seed %llu (path traced)\n", b.spp, b.bounces,
-              u(b.seed));
+  std::printf(
+      "bake        %d spp, %d bounce(s), %d shared light samples a path, seed %llu (path "
+      "traced)\n",
+      b.spp, b.bounces, b.light_samples, u(b.seed));
   print_material(b.material);
 }
 

@@ -40,6 +40,11 @@ void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
   add_checked_option(cmd, "--spp", f.spp,
                      "Surface light field: path-traced samples per texel and direction cell",
                      integer_in(1, 65536));
+  add_checked_option(cmd, "--light-samples", f.light_samples,
+                     "Surface light field: probe samples a path's first light sample is made of, "
+                     "shared by all of a texel's cells (one shadow ray each; 0: every path its "
+                     "own)",
+                     integer_in(0, 4096));
 }
 
 void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
@@ -49,6 +54,7 @@ void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
   std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
       parse_size(f.directions, "--directions", 1, 4096);
   settings.bake.spp = f.spp;
+  settings.bake.light_samples = f.light_samples;
 }
 
 void check_slf_settings(const pipeline::SlfSettings& settings) {

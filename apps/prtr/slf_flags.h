@@ -1,7 +1,7 @@
 // apps/prtr/slf_flags.h: the surface light field's sampling flags (the atlas size, --charts,
-// --directions, --spp), registered with one help text and one set of defaults by the commands that
-// make an SLF: prtr slf (atlas size as --samples) and prtr relight --kind slf (as --slf-samples,
-// since its --samples is the PRT bake's directions per vertex).
+// --directions, --spp, --light-samples), registered with one help text and one set of defaults by
+// the commands that make an SLF: prtr slf (atlas size as --samples) and prtr relight --kind slf (as
+// --slf-samples, since its --samples is the PRT bake's directions per vertex).
 #pragma once
 
 #include "meshes/atlas.h"
@@ -17,6 +17,7 @@ struct SlfFlags {
   std::string samples = "256x256", directions = "32x16",
               charts = std::string(meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal));
   int spp = 16;
+  int light_samples = prt::SlfBakeOptions{}.light_samples;
   const char* samples_flag = "--samples";  // the atlas size's flag name, for messages
 };
 

@@ -30,7 +30,7 @@ void hash_value(std::uint64_t& h, const T& value) {
 
 std::uint64_t bake_key(const meshes::Mesh& mesh, const probes::Probe& probe, const SlfSettings& s) {
   std::uint64_t h = common::kFnvOffset;
-  hash_value(h, std::uint32_t(2));  // this key's layout
+  hash_value(h, std::uint32_t(3));  // this key's layout
   hash_value(h, meshes::content_hash(mesh));
   hash_value(h, prt::probe_hash(probe));
   const prt::SlfBakeOptions& o = s.bake;
@@ -38,7 +38,8 @@ std::uint64_t bake_key(const meshes::Mesh& mesh, const probes::Probe& probe, con
        {std::int64_t(s.atlas_width), std::int64_t(s.atlas_height), std::int64_t(o.grid.azimuth),
         std::int64_t(o.grid.elevation), std::int64_t(o.spp), std::int64_t(o.bounces),
         std::int64_t(o.seed), std::int64_t(o.first_row), std::int64_t(o.end_row),
-        std::int64_t(o.material.kind), std::int64_t(o.material.masking), std::int64_t(s.charts)})
+        std::int64_t(o.material.kind), std::int64_t(o.material.masking), std::int64_t(s.charts),
+        std::int64_t(o.light_samples)})
     hash_value(h, v);
   for (float v : {o.material.albedo.x(), o.material.albedo.y(), o.material.albedo.z(),
                   o.material.specular, o.material.exponent, o.material.roughness, o.material.f0})

@@ -232,6 +232,16 @@ double ProbeSampler::pdf(const Eigen::Vector3d& direction) const {
   return texel_pdf_[std::size_t(y) * width_ + x];
 }
 
+namespace {
+
+// A secondary ray's origin: off the surface along the face normal, on the side it leaves by.
+Eigen::Vector3f ray_origin(const SurfacePoint& p, const Eigen::Vector3d& d, double offset) {
+  const double side = d.dot(p.face_normal) >= 0 ? 1.0 : -1.0;
+  return (p.position + side * offset * p.face_normal).cast<float>();
+}
+
+}  // namespace
+
 // --- PathTracer --------------------------------------------------------------------------------
 
 struct PathTracer::Path {
@@ -240,6 +250,7 @@ struct PathTracer::Path {
   Eigen::Vector3d throughput;
   std::uint64_t key;
   std::uint32_t slot;
+  double shared_light_ratio;  // first vertex only: ExitQuery's
 };
 
 PathTracer::PathTracer(const meshes::Mesh& mesh, const probes::Probe& probe,
@@ -294,8 +305,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
   std::vector<std::uint8_t> blocked;
   std::vector<RayHit> hits;
   const auto origin_for = [&](const SurfacePoint& p, const Eigen::Vector3d& d) {
-    const double side = d.dot(p.face_normal) >= 0 ? 1.0 : -1.0;
-    return Eigen::Vector3f((p.position + side * offset_ * p.face_normal).cast<float>());
+    return ray_origin(p, d, offset_);
   };
   for (int depth = 0; depth <= options_.bounces && !paths.empty(); ++depth) {
     const bool last = depth == options_.bounces;
@@ -318,7 +328,9 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
       // Light sample; its numbers are drawn even when the probe is black, so the BRDF
       // sample's numbers stay the same.
       const double l0 = rng.next(), l1 = rng.next(), l2 = rng.next(), l3 = rng.next();
-      if (lights) {
+      // The light technique's samples per BRDF sample, for the BRDF sample's weight.
+      const double light_n = path.shared_light_ratio > 0 ? path.shared_light_ratio : 1.0;
+      if (lights && !(path.shared_light_ratio > 0)) {
         double p_light = 0;
         const Eigen::Vector3d s_world = sampler_.sample(l0, l1, l2, l3, &p_light);
         const Eigen::Vector3d s = frame.transpose() * s_world;
@@ -346,7 +358,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
       const Eigen::Vector3d s_world = (frame * s).normalized();
       const Eigen::Index k = Eigen::Index(brdf_path.size());
       brdf_through.push_back(path.throughput.cwiseProduct(f) * (s.z() / p_brdf));
-      const double w = lights ? power_weight(p_brdf, sampler_.pdf(s_world)) : 1.0;
+      const double w = lights ? power_weight(p_brdf, light_n * sampler_.pdf(s_world)) : 1.0;
       brdf_value.push_back(brdf_through.back() * w);
       brdf_world.push_back(s_world);
       brdf_dirs.col(k) = s_world.cast<float>();
@@ -396,11 +408,67 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
         p.throughput = brdf_through[std::size_t(k)];
         p.key = mix_key(from.key, 0x5EED0000ULL + std::uint64_t(depth));
         p.slot = from.slot;
+        p.shared_light_ratio = 0;
         next.push_back(p);
       }
     }
     paths.swap(next);
   }
+}
+
+SharedLights PathTracer::sample_lights(const SurfacePoint& point, int count,
+                                       std::uint64_t key) const {
+  SharedLights lights;
+  if (sampler_.empty() || count <= 0) return lights;
+  const std::size_t n = std::size_t(count);
+  lights.direction.resize(n);
+  lights.pdf.resize(n);
+  lights.radiance.assign(n, Eigen::Vector3d::Zero());
+  Eigen::Matrix3Xf origins(3, Eigen::Index(n)), dirs(3, Eigen::Index(n));
+  std::vector<std::uint32_t> traced;
+  const std::uint64_t stream = mix_key(options_.seed, key);
+  for (std::size_t j = 0; j < n; ++j) {
+    RandomStream rng{mix_key(stream, std::uint64_t(j)), 0};
+    const double u0 = (double(j) + rng.next()) / double(n);
+    const double u1 = rng.next(), u2 = rng.next(), u3 = rng.next();
+    double pdf = 0;
+    const Eigen::Vector3d world = sampler_.sample(u0, u1, u2, u3, &pdf);
+    lights.pdf[j] = pdf;
+    lights.direction[j] = point.frame.transpose() * world;
+    if (!(pdf > 0) || lights.direction[j].z() <= 0) continue;
+    const Eigen::Index k = Eigen::Index(traced.size());
+    origins.col(k) = ray_origin(point, world, offset_);
+    dirs.col(k) = world.cast<float>();
+    lights.radiance[j] = probe_.lookup(world).cast<double>();
+    traced.push_back(std::uint32_t(j));
+  }
+  const Eigen::Index m = Eigen::Index(traced.size());
+  if (m == 0) return lights;
+  std::vector<std::uint8_t> blocked(traced.size());
+  scene_->occluded_from(origins.leftCols(m), dirs.leftCols(m), 0.f, blocked.data());
+  for (std::size_t k = 0; k < traced.size(); ++k)
+    if (blocked[k]) lights.radiance[traced[k]] = Eigen::Vector3d::Zero();
+  return lights;
+}
+
+Eigen::Vector3d PathTracer::shared_light_sum(const SurfacePoint& point, const SharedLights& lights,
+                                             const std::vector<Eigen::Vector3d>& views,
+                                             const std::vector<std::uint32_t>& lights_of,
+                                             double ratio) const {
+  const Lobes lobes(material_);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  if (lobes.black) return sum;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    const std::size_t j = lights_of[i];
+    if (!lights.lit(j)) continue;
+    const Eigen::Vector3d v = shading_view(point.frame.transpose() * views[i]);
+    const Eigen::Vector3d& s = lights.direction[j];
+    const Eigen::Vector3d f = lobes.eval(v, s);
+    if (!(f.maxCoeff() > 0)) continue;
+    const double w = power_weight(ratio * lights.pdf[j], lobes.pdf(v, s));
+    sum += f.cwiseProduct(lights.radiance[j]) * (s.z() * w / lights.pdf[j]);
+  }
+  return sum;
 }
 
 void PathTracer::add_exit_radiance(const std::vector<ExitQuery>& queries,
@@ -414,6 +482,7 @@ void PathTracer::add_exit_radiance(const std::vector<ExitQuery>& queries,
     p.throughput = Eigen::Vector3d::Ones();
     p.key = mix_key(options_.seed, q.key);
     p.slot = q.slot;
+    p.shared_light_ratio = q.shared_light_ratio;
     paths.push_back(p);
   }
   trace(paths, out);

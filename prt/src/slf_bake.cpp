@@ -39,11 +39,11 @@ constexpr common::VersionedFormat kSlfFormat{"surface light field file",
 
 constexpr std::size_t kSlfOffWidth = 16, kSlfOffCharts = 18, kSlfOffHeight = 20,
                       kSlfOffAzimuth = 24, kSlfOffElevation = 28, kSlfOffSpp = 32,
-                      kSlfOffBounces = 36, kSlfOffKind = 40, kSlfOffMasking = 44, kSlfOffSeed = 48,
-                      kSlfOffMeshHash = 56, kSlfOffAlbedo = 64, kSlfOffSpecular = 76,
-                      kSlfOffExponent = 80, kSlfOffRoughness = 84, kSlfOffF0 = 88, kSlfOffRows = 92,
-                      kSlfOffFirstRow = 96, kSlfOffRowCount = 100, kSlfOffPayloadChecksum = 104,
-                      kSlfOffProbeHash = 112;
+                      kSlfOffBounces = 36, kSlfOffLightSamples = 38, kSlfOffKind = 40,
+                      kSlfOffMasking = 44, kSlfOffSeed = 48, kSlfOffMeshHash = 56,
+                      kSlfOffAlbedo = 64, kSlfOffSpecular = 76, kSlfOffExponent = 80,
+                      kSlfOffRoughness = 84, kSlfOffF0 = 88, kSlfOffRows = 92, kSlfOffFirstRow = 96,
+                      kSlfOffRowCount = 100, kSlfOffPayloadChecksum = 104, kSlfOffProbeHash = 112;
 constexpr int kMaxSpp = 65536;
 constexpr float kSlfMaxRadiance = 1e20f;
 
@@ -56,7 +56,8 @@ void put_slf_settings(common::VersionedHeader& h, const SlfShape& s) {
   common::put_field(h, kSlfOffAzimuth, std::uint32_t(s.grid.azimuth));
   common::put_field(h, kSlfOffElevation, std::uint32_t(s.grid.elevation));
   common::put_field(h, kSlfOffSpp, std::uint32_t(s.spp));
-  common::put_field(h, kSlfOffBounces, std::uint32_t(s.bounces));
+  common::put_field(h, kSlfOffBounces, std::uint16_t(s.bounces));
+  common::put_field(h, kSlfOffLightSamples, std::uint16_t(s.light_samples));
   common::put_field(h, kSlfOffKind, std::uint32_t(s.material.kind));
   common::put_field(h, kSlfOffMasking, std::uint32_t(s.material.masking));
   common::put_field(h, kSlfOffMeshHash, s.mesh_hash);
@@ -83,7 +84,13 @@ void get_slf_settings(const common::VersionedHeader& h, SlfShape& s) {
   s.grid.azimuth = count(kSlfOffAzimuth);
   s.grid.elevation = count(kSlfOffElevation);
   s.spp = count(kSlfOffSpp);
-  s.bounces = count(kSlfOffBounces);
+  if (common::header_version(h) >= 3) {
+    s.bounces = common::get_field<std::uint16_t>(h, kSlfOffBounces);
+    s.light_samples = common::get_field<std::uint16_t>(h, kSlfOffLightSamples);
+  } else {
+    s.bounces = count(kSlfOffBounces);
+    s.light_samples = 0;
+  }
   s.material.kind = MaterialKind(common::get_field<std::uint32_t>(h, kSlfOffKind));
   s.material.masking = Masking(common::get_field<std::uint32_t>(h, kSlfOffMasking));
   s.mesh_hash = common::get_field<std::uint64_t>(h, kSlfOffMeshHash);
@@ -132,6 +139,8 @@ std::string shape_problem(const SlfShape& s) {
     return "spp " + std::to_string(s.spp) + " out of range";
   if (!in(std::uint64_t(s.bounces), 0, 16))
     return "bounces " + std::to_string(s.bounces) + " out of range";
+  if (!in(std::uint64_t(s.light_samples), 0, 4096))
+    return "light samples " + std::to_string(s.light_samples) + " out of range";
   try {
     s.material.validate();
   } catch (const std::invalid_argument& e) {
@@ -205,30 +214,78 @@ void write_header(const common::AtomicFile& file, const common::VersionedHeader&
   ::close(fd);
 }
 
-// The texel's samples: spp directions per cell of the grid, each uniform in solid angle
-// inside its cell, radiance path traced toward each, averaged per cell.
+// Point i of `count` in the unit square: the first n^2 (n = floor(sqrt(count))) one in each
+// cell of an n x n grid, the rest uniform, so every point is uniform over the square on
+// average and the mean over them is unbiased (stratified sampling; the grid takes the
+// variation across the square out of the estimate).
+Eigen::Vector2d stratified_point(int i, int count, RandomStream& rng) {
+  const int n = int(std::sqrt(double(count)));
+  const double a = rng.next(), b = rng.next();
+  if (i >= n * n) return {a, b};
+  return {(i % n + a) / n, (i / n + b) / n};
+}
+
+// The world direction at (a, b) in [0, 1)^2 over cell (i, j): azimuth linear in a, cosine of
+// the polar angle linear in b, so uniform in solid angle inside the cell.
+Eigen::Vector3d cell_direction(const SlfGrid& grid, int i, int j, double a, double b) {
+  const double top = std::cos(kSlfPi * j / grid.elevation),
+               bottom = std::cos(kSlfPi * (j + 1) / grid.elevation);
+  const double cos_polar = std::clamp(top + b * (bottom - top), -1.0, 1.0);
+  return slf_direction(2 * (i + a) / grid.azimuth, std::acos(cos_polar) / kSlfPi);
+}
+
+// The texel's samples: the mean radiance over each cell of the grid, from spp paths a cell
+// toward views stratified over the cell. With light_samples, the first vertex's light
+// technique is light_samples x spp probe samples shared by all of the texel's cells (one
+// shadow ray each, prt::SharedLights), each cell pairing every one of them with its own view,
+// again stratified over the cell: per cell as many light-view pairs as the paths' own light
+// samples would give light_samples times over, for the price of BRDF evaluations.
 void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_t texel,
               std::uint64_t row, const SlfBakeOptions& o, float* out) {
-  const int z = o.grid.azimuth, w = o.grid.elevation, directions = o.grid.directions();
+  const int z = o.grid.azimuth, directions = o.grid.directions();
   const SurfacePoint point =
       tracer.surface_point(atlas.texel_triangle[texel], atlas.texel_barycentric[texel].x(),
                            atlas.texel_barycentric[texel].y());
   thread_local std::vector<ExitQuery> queries;
-  thread_local std::vector<Eigen::Vector3d> sums;
+  thread_local std::vector<Eigen::Vector3d> sums, views;
+  thread_local std::vector<std::uint32_t> lights_of;
   queries.clear();
   sums.assign(std::size_t(directions), Eigen::Vector3d::Zero());
   const std::uint64_t row_key = mix_key(o.seed ^ 0x51F0000000000000ULL, row);
+  const int shared = o.light_samples * o.spp;
+  const SharedLights lights =
+      o.light_samples > 0 ? tracer.sample_lights(point, shared, mix_key(row_key, 0x11647ULL))
+                          : SharedLights{};
+  const double ratio = lights.size() > 0 ? double(o.light_samples) : 0.0;
   for (int column = 0; column < directions; ++column) {
     const int i = column % z, j = column / z;
-    const double top = std::cos(kSlfPi * j / w), bottom = std::cos(kSlfPi * (j + 1) / w);
     const std::uint64_t column_key = mix_key(row_key, std::uint64_t(column));
     for (int k = 0; k < o.spp; ++k) {
       const std::uint64_t key = mix_key(column_key, std::uint64_t(k));
       RandomStream jitter{key, 0};
-      const double xi1 = 2 * (i + jitter.next()) / z;
-      const double cos_polar = top + jitter.next() * (bottom - top);
-      const double xi2 = std::acos(std::clamp(cos_polar, -1.0, 1.0)) / kSlfPi;
-      queries.push_back(ExitQuery{point, slf_direction(xi1, xi2), key, std::uint32_t(column)});
+      const Eigen::Vector2d ab = stratified_point(k, o.spp, jitter);
+      ExitQuery q{point, cell_direction(o.grid, i, j, ab.x(), ab.y()), key, std::uint32_t(column)};
+      q.shared_light_ratio = ratio;
+      queries.push_back(q);
+    }
+    if (ratio > 0) {
+      // View stratum p takes light sample (first + p) mod count: a random rotation, so that
+      // every pairing of strata is equally likely (the sum is unbiased) and no view stratum
+      // keeps one light sample. Unlit samples need no view.
+      RandomStream jitter{mix_key(column_key, 0x11647ULL), 0};
+      const std::size_t first =
+          std::min(std::size_t(shared) - 1, std::size_t(jitter.next() * shared));
+      views.clear();
+      lights_of.clear();
+      for (int p = 0; p < shared; ++p) {
+        const std::size_t l = (first + std::size_t(p)) % std::size_t(shared);
+        if (!lights.lit(l)) continue;
+        const Eigen::Vector2d ab = stratified_point(p, shared, jitter);
+        views.push_back(cell_direction(o.grid, i, j, ab.x(), ab.y()));
+        lights_of.push_back(std::uint32_t(l));
+      }
+      sums[std::size_t(column)] +=
+          tracer.shared_light_sum(point, lights, views, lights_of, ratio) / o.light_samples;
     }
   }
   tracer.add_exit_radiance(queries, sums.data());
@@ -271,6 +328,7 @@ SlfShape shape_of(const meshes::Mesh& mesh, const meshes::Atlas& atlas, const pr
   s.charts = atlas.charts;
   s.grid = o.grid;
   s.spp = o.spp;
+  s.light_samples = o.light_samples;
   s.bounces = o.bounces;
   s.seed = o.seed;
   s.material = o.material;
@@ -326,6 +384,9 @@ void SlfBakeOptions::validate() const {
   grid.validate();
   if (spp < 1 || spp > kMaxSpp)
     throw std::invalid_argument("--spp must be in [1, 65536], got " + std::to_string(spp));
+  if (light_samples < 0 || light_samples > 4096)
+    throw std::invalid_argument("--light-samples must be in [0, 4096], got " +
+                                std::to_string(light_samples));
   PathTracerOptions tracer;
   tracer.bounces = bounces;
   tracer.ray_offset = ray_offset;
@@ -437,8 +498,8 @@ SlfMatrix join_slf_parts(const std::vector<fs::path>& parts) {
     if (s.atlas_width != w.atlas_width || s.atlas_height != w.atlas_height ||
         s.charts != w.charts || s.grid.azimuth != w.grid.azimuth ||
         s.grid.elevation != w.grid.elevation || s.spp != w.spp || s.bounces != w.bounces ||
-        s.seed != w.seed || s.mesh_hash != w.mesh_hash || s.probe_hash != w.probe_hash ||
-        s.rows != w.rows || s.material.kind != w.material.kind ||
+        s.light_samples != w.light_samples || s.seed != w.seed || s.mesh_hash != w.mesh_hash ||
+        s.probe_hash != w.probe_hash || s.rows != w.rows || s.material.kind != w.material.kind ||
         s.material.albedo != w.material.albedo || s.material.specular != w.material.specular ||
         s.material.exponent != w.material.exponent ||
         s.material.roughness != w.material.roughness || s.material.f0 != w.material.f0 ||

@@ -15,7 +15,7 @@
 // Layout, little-endian: a 128-byte versioned header (common/binary_file.h):
 //   0 magic "PRTRSLFC", 8 u32 version, 12 u32 header bytes (128),
 //   16 u16 atlas width, 18 u16 atlas charts (meshes::AtlasCharts), 20 u32 atlas height,
-//   24 u32 Z, 28 u32 W, 32 u32 spp, 36 u32 bounces,
+//   24 u32 Z, 28 u32 W, 32 u32 spp, 36 u16 bounces, 38 u16 light samples,
 //   40 u32 material kind, 44 u32 masking, 48 u64 rows of the whole matrix (owned texels),
 //   56 u64 mesh content hash, 64 f32[3] albedo, 76 f32 specular, 80 f32 exponent,
 //   84 f32 roughness, 88 f32 f0, 92 u32 clusters K, 96 u32 components N,
@@ -27,7 +27,8 @@
 // u32[V] (zero-padded to a multiple of 8 bytes), weights f32[V N], means f32[K D], bases
 // f32[K N D] with D = 3 Z W; then nothing. A file normally stores every row (first row 0,
 // V = rows); one made from a row range (a measurement) says so and the renderer refuses it.
-// Version 1 (still read) had a u32 atlas width at 16 and always per-triangle charts.
+// Version 1 (still read) had a u32 atlas width at 16 and always per-triangle charts;
+// versions 1 and 2 a u32 bounces at 36 and no shared light samples (read as 0).
 #pragma once
 
 #include "cpca/compressed.h"
@@ -39,7 +40,7 @@
 
 namespace pipeline {
 
-inline constexpr std::uint32_t kSlfcFileVersion = 2;
+inline constexpr std::uint32_t kSlfcFileVersion = 3;
 inline constexpr std::size_t kMaxSlfcNameBytes = 4096;
 
 class SlfcFileError : public std::runtime_error {

@@ -9,7 +9,9 @@
 // times solid angle) and one of the BRDF (cosine lobe and the specular lobe: Phong's cosine
 // power about the mirror direction, Beckmann's half vectors for Cook-Torrance) are combined
 // by Veach's power heuristic (Veach & Guibas, "Optimally combining sampling techniques for
-// Monte Carlo rendering", 1995). A BRDF sample that hits the front of a triangle continues
+// Monte Carlo rendering", 1995); a caller with many views of one point may replace the first
+// vertex's probe sample by samples it shares among them (SharedLights, the multi-sample
+// model with unequal counts). A BRDF sample that hits the front of a triangle continues
 // the path while bounces remain: `bounces` = 1 is one interreflection, as the PRT bake's
 // --bounces; 0 is direct light with shadows. Back faces block light and send none, as in the
 // bake. A view below the shading normal's tangent plane is taken as the most grazing view
@@ -75,13 +77,31 @@ struct SurfacePoint {
   Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();
 };
 
+// Samples of the probe taken once at a surface point and shared by many views of it (the
+// surface light field's texel, prt/slf_bake.h): the light rays do not depend on the view, so
+// a texel's 512 cells can share a few hundred shadow rays instead of tracing one per path.
+// Directions are in the point's shading frame; radiance is the probe's where the direction
+// is above the shading plane and unoccluded, zero where not (such samples still count).
+struct SharedLights {
+  std::vector<Eigen::Vector3d> direction;
+  std::vector<double> pdf;  // the probe sampler's density, per steradian
+  std::vector<Eigen::Vector3d> radiance;
+  std::size_t size() const { return pdf.size(); }
+  bool lit(std::size_t j) const { return radiance[j].maxCoeff() > 0; }
+};
+
 // One radiance sample to take: leaving `point` toward the world direction `view` (unit),
 // with random numbers keyed by `key`; its value is added to slot `slot` of the output.
+// With `shared_light_ratio` > 0 the caller estimates the first vertex's light technique
+// itself from shared samples (PathTracer::shared_light_sum), that many per such query: the
+// path then takes no probe sample there and weights its BRDF sample for that many (Veach's
+// multi-sample model).
 struct ExitQuery {
   SurfacePoint point;
   Eigen::Vector3d view = Eigen::Vector3d::UnitZ();
   std::uint64_t key = 0;
   std::uint32_t slot = 0;
+  double shared_light_ratio = 0;
 };
 
 class PathTracer {
@@ -102,6 +122,20 @@ class PathTracer {
   // Adds one radiance sample per query to out[query.slot] (RGB). Traces all queries' rays
   // together, one stream per kind of ray and depth; call from many threads at once.
   void add_exit_radiance(const std::vector<ExitQuery>& queries, Eigen::Vector3d* out) const;
+
+  // `count` probe samples at `point`, stratified over the sampler's table (sample j draws
+  // its first number in [j, j + 1) / count), with one shadow ray each, keyed by `key`.
+  SharedLights sample_lights(const SurfacePoint& point, int count, std::uint64_t key) const;
+
+  // The light technique at `point` from shared samples for many views: the sum over pairs i
+  // of w f(v_i, s_j) L_j cos_j / p_j, j = lights_of[i], each weighted by the power heuristic
+  // against the BRDF technique for `ratio` light samples per BRDF sample (the ExitQuery's
+  // shared_light_ratio). Views are world-space unit vectors, below-horizon ones clamped as
+  // the paths clamp them. Pairs with unlit samples add nothing and may be left out. Not
+  // divided by the number of pairs.
+  Eigen::Vector3d shared_light_sum(const SurfacePoint& point, const SharedLights& lights,
+                                   const std::vector<Eigen::Vector3d>& views,
+                                   const std::vector<std::uint32_t>& lights_of, double ratio) const;
 
   // The mean of `spp` samples of the radiance leaving `point` toward `view`.
   Eigen::Vector3d exit_radiance(const SurfacePoint& point, const Eigen::Vector3d& view, int spp,

@@ -6,24 +6,30 @@
 // texels of triangle -1 skipped: slf_rows), and 3 Z W columns, (direction j Z + i, channel),
 // RGB innermost, as render/slf_model.h lays out the view maps. A texel samples its surface
 // point (the atlas's barycentrics) with the interpolated per-vertex frame. Entry (t, d) is the
-// mean radiance over direction d's cell, not its centre: each of the `spp` samples takes a
-// direction uniformly distributed in solid angle inside the cell (azimuth uniform, cosine of
-// the polar angle uniform), so the grid is prefiltered. A view below the shading tangent
-// plane gets the radiance of the most grazing view above it (prt::clamp_to_horizon), so
-// silhouettes do not go dark.
+// mean radiance over direction d's cell, not its centre: the `spp` paths take views spread
+// over the cell (stratified in azimuth and cosine of the polar angle, so uniform in solid
+// angle), so the grid is prefiltered. A view below the shading tangent plane gets the
+// radiance of the most grazing view above it (prt::clamp_to_horizon), so silhouettes do not
+// go dark. With `light_samples` (default 8) the paths' first light sample comes from
+// light_samples x spp probe samples the texel traces once and every cell reuses, each paired
+// with a view of its own (prt::SharedLights): for the glossy bunny and horse under the forest
+// probe, a cell's noise in front of its texel falls about 2 x for 5-15 % more time
+// (docs/BENCHMARKS.md, "Bake noise").
 //
 // The .slf file holds the matrix (or a range of its rows, for processes that bake parts)
 // after a 128-byte versioned header (common/binary_file.h), little-endian:
 //   0 magic "PRTRSLFM", 8 u32 version, 12 u32 header bytes (128),
 //   16 u16 atlas width, 18 u16 atlas charts (meshes::AtlasCharts), 20 u32 atlas height,
 //   24 u32 Z (azimuth cells), 28 u32 W (polar cells),
-//   32 u32 spp, 36 u32 bounces, 40 u32 material kind, 44 u32 masking, 48 u64 seed,
+//   32 u32 spp, 36 u16 bounces, 38 u16 light samples, 40 u32 material kind, 44 u32 masking,
+//   48 u64 seed,
 //   56 u64 mesh content hash, 64 f32[3] albedo, 76 f32 specular, 80 f32 exponent,
 //   84 f32 roughness, 88 f32 f0, 92 u32 rows of the whole matrix, 96 u32 first row stored,
 //   100 u32 rows stored, 104 u64 FNV-1a of the payload, 112 u64 FNV-1a of the probe's texels,
 //   120 u64 FNV-1a of bytes [0, 120),
 // then rows stored x 3 Z W float32, then nothing. Version 1 (still read) had a u32 atlas
 // width at 16 and always per-triangle charts; its widths (at most 8192) left bytes 18-19 zero.
+// Versions 1 and 2 had a u32 bounces at 36 and no shared light samples: they read as 0.
 #pragma once
 
 #include "common/binary_file.h"
@@ -42,7 +48,7 @@
 
 namespace prt {
 
-inline constexpr std::uint32_t kSlfFileVersion = 2;
+inline constexpr std::uint32_t kSlfFileVersion = 3;
 
 class SlfFileError : public std::runtime_error {
  public:
@@ -51,7 +57,11 @@ class SlfFileError : public std::runtime_error {
 
 struct SlfBakeOptions {
   SlfGrid grid;
-  int spp = 16;     // samples per texel and direction, in [1, 65536]
+  int spp = 16;  // samples per texel and direction, in [1, 65536]
+  // > 0: each path's first light sample is this many probe samples shared by all the
+  // texel's paths (prt::SharedLights; light_samples x spp shadow rays a texel, the same for
+  // every cell); 0: each path draws and traces its own. In [0, 4096].
+  int light_samples = 8;
   int bounces = 1;  // interreflections (prt/path_tracer.h)
   std::uint64_t seed = 1;
   Material material;
@@ -74,6 +84,7 @@ struct SlfShape {
   meshes::AtlasCharts charts = meshes::AtlasCharts::kConformal;
   SlfGrid grid;
   int spp = 0, bounces = 0;
+  int light_samples = 0;  // SlfBakeOptions::light_samples
   std::uint64_t seed = 0;
   Material material;
   std::uint64_t mesh_hash = 0, probe_hash = 0;
@@ -89,10 +100,12 @@ struct SlfMatrix {
 };
 
 // Both SLF files (.slf here, pipeline's .slfc) record the bake's settings in the same header
-// fields: bytes 16-47 (atlas size and charts, grid, spp, bounces, material kind and masking),
+// fields: bytes 16-47 (atlas size and charts, grid, spp, bounces, light samples, material
+// kind and masking),
 // 56-91 (mesh hash, albedo, specular, exponent, roughness, f0) and 112 (probe hash). Reading
 // clamps counts to 2^30 so a hostile header cannot overflow an int; the caller validates
-// (slf_settings_problem). A version 1 header (both files) reads as per-triangle charts.
+// (slf_settings_problem). A version 1 header (both files) reads as per-triangle charts, a
+// version 1 or 2 header as no shared light samples.
 void put_slf_settings(common::VersionedHeader& header, const SlfShape& shape);
 void get_slf_settings(const common::VersionedHeader& header, SlfShape& shape);
 // Empty when the chart method is one make_atlas knows; else the problem, naming it.
