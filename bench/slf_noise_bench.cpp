@@ -1,15 +1,19 @@
 // slf_noise_bench [--mesh M] [--probe P] [--rows R] [--spp S] [--truth-spp T] [--seeds N]
-// [--light-samples L,...] [--bounces B] [--samples WxH] [--directions ZxW] [--roughness m]:
-// how noisy the surface light field's bake (prt/slf_bake.h) is for the time it takes, per
-// estimator. R rows, in eight runs spread over the atlas, are baked once at T paths a cell
-// (the truth) and N times (seeds 2..N+1) at S paths a cell with each light-sample setting;
-// every row prints the relative RMS difference from the truth over those rows' entries
-// (sqrt(sum (b - t)^2 / sum t^2)), the bake's seconds, and the efficiency 1 / (error^2 x
-// seconds) that compares estimators whose costs differ. The truth's own noise is taken out
-// (its estimator's variance at T paths, from the S-path runs of the same estimator), so the
-// figures are the bakes' noise. Defaults: the Stanford bunny, the forest probe, Cook-Torrance
-// m 0.1 (specular 0.5, albedo 0.3), 256 x 256 conformal atlas, 32 x 16 directions, 1 bounce,
-// 256 rows, S 16, T 1024, 2 seeds, light samples 0 (the path tracer's own) and 16.
+// [--light-samples L,...] [--bounces B] [--samples WxH] [--directions ZxW] [--roughness m]
+// [--time-rows Q]: how noisy the surface light field's bake (prt/slf_bake.h) is for the time
+// it takes, per estimator. R rows, in eight runs spread over the atlas, are baked once at T
+// paths a cell (the truth, with the first light-sample setting) and N times (seeds 2..N+1)
+// at S paths a cell with each setting; a row of the table gives the relative RMS difference
+// from the truth over those entries (sqrt(sum (b - t)^2 / sum t^2)) with the truth's own
+// noise taken out (its estimator's variance at T paths, from the S-path runs), the seconds a
+// bake of 1,000 rows takes (timed on Q rows in one range, so the ray scene is built once as
+// in a whole bake), and the efficiency 1 / (noise^2 x seconds), which compares estimators of
+// different costs, over all entries and over the cells in front of their texel (their
+// centre at least 0.25 above the shading plane in cosine), which make nearly every pixel of
+// an image. The noise of the front, grazing and behind cells follows, each with its share
+// of the squared noise. Defaults: the Stanford bunny, the forest probe, Cook-Torrance m 0.1
+// (specular 0.5, albedo 0.3), 256 x 256 conformal atlas, 32 x 16 directions, 1 bounce, R 256,
+// S 16, T 1024, N 2, Q 2048, light samples 0 (the paths' own) and 16.
 #include "meshes/atlas.h"
 #include "meshes/load.h"
 #include "probes/load.h"
@@ -35,7 +39,7 @@ struct UsageError : std::runtime_error {
 struct Args {
   std::string mesh = "/usr/share/glmark2/models/bunny.obj";
   std::string probe = "/usr/share/blender/datafiles/studiolights/world/forest.exr";
-  int rows = 256, spp = 16, truth_spp = 1024, seeds = 2, bounces = 1;
+  int rows = 256, spp = 16, truth_spp = 1024, seeds = 2, bounces = 1, time_rows = 2048;
   int atlas_width = 256, atlas_height = 256, azimuth = 32, elevation = 16;
   float roughness = 0.1f;
   std::vector<int> light_samples{0, 16};
@@ -66,6 +70,8 @@ Args parse(int argc, char** argv) {
       a.probe = value;
     else if (flag == "--rows")
       a.rows = number(8, 1 << 20);
+    else if (flag == "--time-rows")
+      a.time_rows = number(1, 1 << 24);
     else if (flag == "--spp")
       a.spp = number(1, 65536);
     else if (flag == "--truth-spp")
@@ -137,6 +143,20 @@ std::vector<std::uint8_t> view_classes(const meshes::Mesh& mesh, const meshes::A
   return out;
 }
 
+// Seconds per 1,000 rows: one range of `rows` rows from the middle of the atlas, so the
+// tracer's scene is built once, as in a whole bake (the noise rows' eight ranges build it
+// eight times, which on the bunny costs more than baking them).
+double seconds_per_1000_rows(const meshes::Mesh& mesh, const meshes::Atlas& atlas,
+                             const probes::Probe& probe, prt::SlfBakeOptions o, int rows) {
+  const std::uint64_t total = atlas.used_texels();
+  o.first_row = total / 2 - std::min<std::uint64_t>(total / 2, std::uint64_t(rows) / 2);
+  o.end_row = std::min(total, o.first_row + std::uint64_t(rows));
+  const auto start = std::chrono::steady_clock::now();
+  prt::bake_slf(mesh, atlas, probe, o);
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return 1000.0 * s / double(o.end_row - o.first_row);
+}
+
 // The rows of eight evenly spaced runs of rows / 8 each.
 Bake bake_runs(const meshes::Mesh& mesh, const meshes::Atlas& atlas, const probes::Probe& probe,
                prt::SlfBakeOptions o, int rows) {
@@ -206,9 +226,11 @@ int main(int argc, char** argv) {
         "behind %.2f\n",
         truth.seconds, o.light_samples, truth_energy[0] / truth_energy[kViewClasses],
         truth_energy[1] / truth_energy[kViewClasses], truth_energy[2] / truth_energy[kViewClasses]);
-    std::printf("| light samples | relative RMS noise | seconds | efficiency 1 / (noise^2 s) |");
+    std::printf(
+        "| light samples | relative RMS noise | seconds / 1000 rows | efficiency 1 / (noise^2 s) "
+        "| front's efficiency |");
     for (const char* name : kViewClassNames) std::printf(" %s: noise, share |", name);
-    std::printf("\n| ---: | ---: | ---: | ---: |");
+    std::printf("\n| ---: | ---: | ---: | ---: | ---: |");
     for (int c = 0; c < kViewClasses; ++c) std::printf(" ---: |");
     std::printf("\n");
     std::array<double, kViewClasses + 1> truth_variance{};  // the truth's, summed over entries
@@ -221,12 +243,11 @@ int main(int argc, char** argv) {
         bakes.push_back(bake_runs(mesh, atlas, probe, o, args.rows));
       }
       std::array<double, kViewClasses + 1> against{};
-      double seconds = 0;
       for (const Bake& b : bakes) {
         const auto d = squared_difference(b.values, truth.values, cls);
         for (int c = 0; c <= kViewClasses; ++c) against[c] += d[c] / args.seeds;
-        seconds += b.seconds / args.seeds;
       }
+      const double seconds = seconds_per_1000_rows(mesh, atlas, probe, o, args.time_rows);
       // The truth's estimator is the first setting: its S-path variance, scaled to T paths.
       if (e == 0) {
         int pairs = 0;
@@ -244,8 +265,9 @@ int main(int argc, char** argv) {
       for (int c = 0; c <= kViewClasses; ++c)
         noise2[c] = std::max(0.0, against[c] - truth_variance[c]);
       const double noise = std::sqrt(noise2[kViewClasses] / truth_energy[kViewClasses]);
-      std::printf("| %d | %.2f %% | %.2f | %.3g |", o.light_samples, 100 * noise, seconds,
-                  1.0 / (noise * noise * seconds));
+      const double front2 = noise2[0] / truth_energy[0];
+      std::printf("| %d | %.2f %% | %.2f | %.3g | %.3g |", o.light_samples, 100 * noise, seconds,
+                  1.0 / (noise * noise * seconds), 1.0 / (front2 * seconds));
       for (int c = 0; c < kViewClasses; ++c)
         std::printf(" %.1f %%, %.2f |", 100 * std::sqrt(noise2[c] / truth_energy[c]),
                     noise2[c] / noise2[kViewClasses]);

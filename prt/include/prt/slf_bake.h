@@ -10,11 +10,11 @@
 // over the cell (stratified in azimuth and cosine of the polar angle, so uniform in solid
 // angle), so the grid is prefiltered. A view below the shading tangent plane gets the
 // radiance of the most grazing view above it (prt::clamp_to_horizon), so silhouettes do not
-// go dark. With `light_samples` (default 8) the paths' first light sample comes from
+// go dark. With `light_samples` (default 4) the paths' first light sample comes from
 // light_samples x spp probe samples the texel traces once and every cell reuses, each paired
 // with a view of its own (prt::SharedLights): for the glossy bunny and horse under the forest
-// probe, a cell's noise in front of its texel falls about 2 x for 5-15 % more time
-// (docs/BENCHMARKS.md, "Bake noise").
+// probe the noise of the cells in front of their texel falls from 27 to 15 % in about the
+// same time (docs/BENCHMARKS.md, "Bake noise").
 //
 // The .slf file holds the matrix (or a range of its rows, for processes that bake parts)
 // after a 128-byte versioned header (common/binary_file.h), little-endian:
@@ -61,7 +61,7 @@ struct SlfBakeOptions {
   // > 0: each path's first light sample is this many probe samples shared by all the
   // texel's paths (prt::SharedLights; light_samples x spp shadow rays a texel, the same for
   // every cell); 0: each path draws and traces its own. In [0, 4096].
-  int light_samples = 8;
+  int light_samples = 4;
   int bounces = 1;  // interreflections (prt/path_tracer.h)
   std::uint64_t seed = 1;
   Material material;
