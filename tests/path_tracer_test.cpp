@@ -136,27 +136,20 @@ struct QuadratureCase {
   }
 };
 
-prt::Material glossy_phong() {
+// A glossy material of either kind: Phong of exponent 30 or Cook-Torrance of roughness 0.15.
+prt::Material glossy(prt::MaterialKind kind) {
   prt::Material m;
-  m.kind = prt::MaterialKind::kPhong;
+  m.kind = kind;
   m.albedo = Eigen::Vector3f(0.3f, 0.4f, 0.5f);
-  m.specular = 0.4f;
+  m.specular = kind == prt::MaterialKind::kPhong ? 0.4f : 0.5f;
   m.exponent = 30.f;
-  return m;
-}
-
-prt::Material glossy_cook_torrance() {
-  prt::Material m;
-  m.kind = prt::MaterialKind::kCookTorrance;
-  m.albedo = Eigen::Vector3f(0.3f, 0.4f, 0.5f);
-  m.specular = 0.5f;
   m.roughness = 0.15f;
   return m;
 }
 
 TEST(PathTracer, MisEstimateMatchesADenseQuadrature) {
   const QuadratureCase q;
-  const prt::Material m = glossy_phong();
+  const prt::Material m = glossy(prt::MaterialKind::kPhong);
   prt::PathTracerOptions options;
   options.bounces = 0;
   const prt::PathTracer tracer(q.plane, q.probe, m, options);
@@ -171,7 +164,8 @@ TEST(PathTracer, MisEstimateMatchesADenseQuadrature) {
 // shared_light_ratio) together estimate the same integral, for several sharing ratios.
 TEST(PathTracer, SharedLightSamplesMatchADenseQuadrature) {
   const QuadratureCase q;
-  for (const prt::Material& m : {glossy_phong(), glossy_cook_torrance()}) {
+  for (const prt::Material& m :
+       {glossy(prt::MaterialKind::kPhong), glossy(prt::MaterialKind::kCookTorrance)}) {
     prt::PathTracerOptions options;
     options.bounces = 0;
     const prt::PathTracer tracer(q.plane, q.probe, m, options);
@@ -213,7 +207,7 @@ TEST(PathTracer, SharedLightSamplesAreShadowed) {
       meshes::merge({meshes::make_plane(4.f, 2, 0.f), meshes::make_plane(40.f, 2, 1.f)});
   meshes::compute_frames(two);
   const probes::Probe sky = probes::make_constant(64, 32, probes::Rgb(1, 1, 1));
-  const prt::PathTracer covered(two, sky, glossy_phong());
+  const prt::PathTracer covered(two, sky, glossy(prt::MaterialKind::kPhong));
   const prt::SurfacePoint p = centroid(covered, 1);
   const prt::SharedLights lights = covered.sample_lights(p, 256, 9);
   ASSERT_EQ(lights.size(), 256u);
@@ -228,7 +222,7 @@ TEST(PathTracer, SharedLightSamplesAreShadowed) {
   EXPECT_LT(lit, 16);
   // Without the upper plane every sample above the horizon sees the sky, about half.
   const meshes::Mesh one = meshes::make_plane(4.f, 2, 0.f);
-  const prt::PathTracer open(one, sky, glossy_phong());
+  const prt::PathTracer open(one, sky, glossy(prt::MaterialKind::kPhong));
   const prt::SharedLights seen = open.sample_lights(centroid(open, 1), 256, 9);
   int above = 0;
   for (std::size_t j = 0; j < seen.size(); ++j) {
