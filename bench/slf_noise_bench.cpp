@@ -28,6 +28,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -114,12 +115,14 @@ struct Bake {
 constexpr int kViewClasses = 3;
 constexpr const char* kViewClassNames[kViewClasses] = {"front", "grazing", "behind"};
 
-std::vector<std::uint64_t> bench_rows(const meshes::Atlas& atlas, int rows) {
+// The rows measured: eight evenly spaced ranges [first, end) of rows / 8 each.
+std::vector<std::pair<std::uint64_t, std::uint64_t>> bench_ranges(const meshes::Atlas& atlas,
+                                                                  int rows) {
   const std::uint64_t total = atlas.used_texels(), run = std::uint64_t(rows / 8);
-  std::vector<std::uint64_t> out;
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> out;
   for (int r = 0; r < 8; ++r) {
     const std::uint64_t first = total * std::uint64_t(2 * r + 1) / 16;
-    for (std::uint64_t k = first; k < std::min(total, first + run); ++k) out.push_back(k);
+    out.emplace_back(first, std::min(total, first + run));
   }
   return out;
 }
@@ -130,16 +133,17 @@ std::vector<std::uint8_t> view_classes(const meshes::Mesh& mesh, const meshes::A
   const prt::PathTracer tracer(mesh, probe, o.material);
   const std::vector<std::uint32_t> texels = prt::slf_rows(atlas);
   std::vector<std::uint8_t> out;
-  for (std::uint64_t row : bench_rows(atlas, rows)) {
-    const std::uint32_t t = texels[row];
-    const prt::SurfacePoint p = tracer.surface_point(
-        atlas.texel_triangle[t], atlas.texel_barycentric[t].x(), atlas.texel_barycentric[t].y());
-    for (int c = 0; c < o.grid.directions(); ++c) {
-      const double z = p.frame.col(2).dot(prt::slf_grid_direction(o.grid, c));
-      const std::uint8_t k = z >= 0.25 ? 0 : z >= -0.25 ? 1 : 2;
-      out.insert(out.end(), 3, k);
+  for (const auto& [first, end] : bench_ranges(atlas, rows))
+    for (std::uint64_t row = first; row < end; ++row) {
+      const std::uint32_t t = texels[row];
+      const prt::SurfacePoint p = tracer.surface_point(
+          atlas.texel_triangle[t], atlas.texel_barycentric[t].x(), atlas.texel_barycentric[t].y());
+      for (int c = 0; c < o.grid.directions(); ++c) {
+        const double z = p.frame.col(2).dot(prt::slf_grid_direction(o.grid, c));
+        const std::uint8_t k = z >= 0.25 ? 0 : z >= -0.25 ? 1 : 2;
+        out.insert(out.end(), 3, k);
+      }
     }
-  }
   return out;
 }
 
@@ -157,15 +161,14 @@ double seconds_per_1000_rows(const meshes::Mesh& mesh, const meshes::Atlas& atla
   return 1000.0 * s / double(o.end_row - o.first_row);
 }
 
-// The rows of eight evenly spaced runs of rows / 8 each.
+// The bench_ranges rows, baked.
 Bake bake_runs(const meshes::Mesh& mesh, const meshes::Atlas& atlas, const probes::Probe& probe,
                prt::SlfBakeOptions o, int rows) {
-  const std::uint64_t total = atlas.used_texels(), run = std::uint64_t(rows / 8);
   Bake b;
   const auto start = std::chrono::steady_clock::now();
-  for (int r = 0; r < 8; ++r) {
-    o.first_row = total * std::uint64_t(2 * r + 1) / 16;
-    o.end_row = std::min(total, o.first_row + run);
+  for (const auto& [first, end] : bench_ranges(atlas, rows)) {
+    o.first_row = first;
+    o.end_row = end;
     const prt::SlfMatrix m = prt::bake_slf(mesh, atlas, probe, o);
     b.values.insert(b.values.end(), m.data.begin(), m.data.end());
   }

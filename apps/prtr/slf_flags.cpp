@@ -44,7 +44,7 @@ void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
                      "Surface light field: probe samples a path's first light sample is made of, "
                      "shared by all of a texel's cells (one shadow ray each; 0: every path its "
                      "own)",
-                     integer_in(0, 4096));
+                     integer_in(0, prt::kMaxLightSamples));
 }
 
 void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {

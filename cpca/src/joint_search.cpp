@@ -575,7 +575,6 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
     r.objective.push_back((total + mu * double(r.triangles_drawn)) / double(data.rows()));
   }
   const VertexTriangles vt(std::size_t(data.rows()), geometry.triangles);
-  const Eigen::VectorXf norms = data.rowwise().squaredNorm();
   if (options.error_target > 0) {
     // The epsilon-constraint search: the price of a drawn triangle is a Lagrange multiplier
     // found by the search itself (below), so no weight needs setting per mesh or K.
@@ -607,6 +606,7 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
     r.pass_of = std::move(pass_of);
     return r;
   }
+  const Eigen::VectorXf norms = data.rowwise().squaredNorm();
   for (int i = 1; i <= options.max_steps && total_of(vertex_error) > 0; ++i) {
     r.tried = i;
     if (!step(data, geometry, vt, norms, options, mu, set, vertex_error, pass_of, r)) break;

@@ -83,7 +83,8 @@ std::string slfc_problem(const CompressedSlf& slf) {
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
-  if (b.spp < 1 || b.bounces < 0 || b.bounces > 16 || b.light_samples < 0 || b.light_samples > 4096)
+  if (b.spp < 1 || b.bounces < 0 || b.bounces > 16 || b.light_samples < 0 ||
+      b.light_samples > prt::kMaxLightSamples)
     return "spp, bounces or light samples out of range";
   if (b.rows > std::uint64_t(b.atlas_width) * std::uint64_t(b.atlas_height) ||
       b.first_row > b.rows || b.row_count > b.rows - b.first_row || b.row_count == 0)

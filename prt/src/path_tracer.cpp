@@ -240,6 +240,18 @@ Eigen::Vector3f ray_origin(const SurfacePoint& p, const Eigen::Vector3d& d, doub
   return (p.position + side * offset * p.face_normal).cast<float>();
 }
 
+// A probe sample's share of the light technique, f L cos w / p (view v and sample s in the
+// shading frame, s above it), weighted by the power heuristic against the BRDF technique
+// with `count` light samples per BRDF sample. Zero where the BRDF is.
+Eigen::Vector3d light_sample_value(const Lobes& lobes, const Eigen::Vector3d& v,
+                                   const Eigen::Vector3d& s, const Eigen::Vector3d& radiance,
+                                   double pdf, double count) {
+  const Eigen::Vector3d f = lobes.eval(v, s);
+  if (!(f.maxCoeff() > 0)) return Eigen::Vector3d::Zero();
+  const double w = power_weight(count * pdf, lobes.pdf(v, s));
+  return f.cwiseProduct(radiance) * (s.z() * w / pdf);
+}
+
 }  // namespace
 
 // --- PathTracer --------------------------------------------------------------------------------
@@ -304,9 +316,6 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
   std::vector<std::uint32_t> light_path, brdf_path;
   std::vector<std::uint8_t> blocked;
   std::vector<RayHit> hits;
-  const auto origin_for = [&](const SurfacePoint& p, const Eigen::Vector3d& d) {
-    return ray_origin(p, d, offset_);
-  };
   for (int depth = 0; depth <= options_.bounces && !paths.empty(); ++depth) {
     const bool last = depth == options_.bounces;
     const std::size_t n = paths.size();
@@ -335,15 +344,13 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
         const Eigen::Vector3d s_world = sampler_.sample(l0, l1, l2, l3, &p_light);
         const Eigen::Vector3d s = frame.transpose() * s_world;
         if (p_light > 0 && s.z() > 0) {
-          const Eigen::Vector3d f = lobes.eval(v, s);
-          if (f.maxCoeff() > 0) {
-            const double w = power_weight(p_light, lobes.pdf(v, s));
-            const Eigen::Vector3d le = probe_.lookup(s_world).cast<double>();
+          const Eigen::Vector3d value =
+              light_sample_value(lobes, v, s, probe_.lookup(s_world).cast<double>(), p_light, 1.0);
+          if (value.maxCoeff() > 0) {
             const Eigen::Index k = Eigen::Index(light_path.size());
-            light_value.push_back(path.throughput.cwiseProduct(f.cwiseProduct(le)) *
-                                  (s.z() * w / p_light));
+            light_value.push_back(path.throughput.cwiseProduct(value));
             light_dirs.col(k) = s_world.cast<float>();
-            light_origins.col(k) = origin_for(path.point, s_world);
+            light_origins.col(k) = ray_origin(path.point, s_world, offset_);
             light_path.push_back(i);
           }
         }
@@ -362,7 +369,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
       brdf_value.push_back(brdf_through.back() * w);
       brdf_world.push_back(s_world);
       brdf_dirs.col(k) = s_world.cast<float>();
-      brdf_origins.col(k) = origin_for(path.point, s_world);
+      brdf_origins.col(k) = ray_origin(path.point, s_world, offset_);
       brdf_path.push_back(i);
     }
     // Shadow rays of the light samples.
@@ -462,11 +469,8 @@ Eigen::Vector3d PathTracer::shared_light_sum(const SurfacePoint& point, const Sh
     const std::size_t j = lights_of[i];
     if (!lights.lit(j)) continue;
     const Eigen::Vector3d v = shading_view(point.frame.transpose() * views[i]);
-    const Eigen::Vector3d& s = lights.direction[j];
-    const Eigen::Vector3d f = lobes.eval(v, s);
-    if (!(f.maxCoeff() > 0)) continue;
-    const double w = power_weight(ratio * lights.pdf[j], lobes.pdf(v, s));
-    sum += f.cwiseProduct(lights.radiance[j]) * (s.z() * w / lights.pdf[j]);
+    sum +=
+        light_sample_value(lobes, v, lights.direction[j], lights.radiance[j], lights.pdf[j], ratio);
   }
   return sum;
 }

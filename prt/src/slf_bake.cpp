@@ -139,7 +139,7 @@ std::string shape_problem(const SlfShape& s) {
     return "spp " + std::to_string(s.spp) + " out of range";
   if (!in(std::uint64_t(s.bounces), 0, 16))
     return "bounces " + std::to_string(s.bounces) + " out of range";
-  if (!in(std::uint64_t(s.light_samples), 0, 4096))
+  if (!in(std::uint64_t(s.light_samples), 0, kMaxLightSamples))
     return "light samples " + std::to_string(s.light_samples) + " out of range";
   try {
     s.material.validate();
@@ -225,13 +225,21 @@ Eigen::Vector2d stratified_point(int i, int count, RandomStream& rng) {
   return {(i % n + a) / n, (i / n + b) / n};
 }
 
-// The world direction at (a, b) in [0, 1)^2 over cell (i, j): azimuth linear in a, cosine of
+// Cell (i, j) of the grid: azimuth cell i, and the cosines of its polar edges.
+struct GridCell {
+  int i;
+  double top, bottom;
+  GridCell(const SlfGrid& grid, int column)
+      : i(column % grid.azimuth),
+        top(std::cos(kSlfPi * (column / grid.azimuth) / grid.elevation)),
+        bottom(std::cos(kSlfPi * (column / grid.azimuth + 1) / grid.elevation)) {}
+};
+
+// The world direction at (a, b) in [0, 1)^2 over the cell: azimuth linear in a, cosine of
 // the polar angle linear in b, so uniform in solid angle inside the cell.
-Eigen::Vector3d cell_direction(const SlfGrid& grid, int i, int j, double a, double b) {
-  const double top = std::cos(kSlfPi * j / grid.elevation),
-               bottom = std::cos(kSlfPi * (j + 1) / grid.elevation);
-  const double cos_polar = std::clamp(top + b * (bottom - top), -1.0, 1.0);
-  return slf_direction(2 * (i + a) / grid.azimuth, std::acos(cos_polar) / kSlfPi);
+Eigen::Vector3d cell_direction(const SlfGrid& grid, const GridCell& cell, double a, double b) {
+  const double cos_polar = std::clamp(cell.top + b * (cell.bottom - cell.top), -1.0, 1.0);
+  return slf_direction(2 * (cell.i + a) / grid.azimuth, std::acos(cos_polar) / kSlfPi);
 }
 
 // The texel's samples: the mean radiance over each cell of the grid, from spp paths a cell
@@ -242,7 +250,7 @@ Eigen::Vector3d cell_direction(const SlfGrid& grid, int i, int j, double a, doub
 // samples would give light_samples times over, for the price of BRDF evaluations.
 void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_t texel,
               std::uint64_t row, const SlfBakeOptions& o, float* out) {
-  const int z = o.grid.azimuth, directions = o.grid.directions();
+  const int directions = o.grid.directions();
   const SurfacePoint point =
       tracer.surface_point(atlas.texel_triangle[texel], atlas.texel_barycentric[texel].x(),
                            atlas.texel_barycentric[texel].y());
@@ -258,13 +266,13 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
                           : SharedLights{};
   const double ratio = lights.size() > 0 ? double(o.light_samples) : 0.0;
   for (int column = 0; column < directions; ++column) {
-    const int i = column % z, j = column / z;
+    const GridCell cell(o.grid, column);
     const std::uint64_t column_key = mix_key(row_key, std::uint64_t(column));
     for (int k = 0; k < o.spp; ++k) {
       const std::uint64_t key = mix_key(column_key, std::uint64_t(k));
       RandomStream jitter{key, 0};
       const Eigen::Vector2d ab = stratified_point(k, o.spp, jitter);
-      ExitQuery q{point, cell_direction(o.grid, i, j, ab.x(), ab.y()), key, std::uint32_t(column)};
+      ExitQuery q{point, cell_direction(o.grid, cell, ab.x(), ab.y()), key, std::uint32_t(column)};
       q.shared_light_ratio = ratio;
       queries.push_back(q);
     }
@@ -281,7 +289,7 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
         const std::size_t l = (first + std::size_t(p)) % std::size_t(shared);
         if (!lights.lit(l)) continue;
         const Eigen::Vector2d ab = stratified_point(p, shared, jitter);
-        views.push_back(cell_direction(o.grid, i, j, ab.x(), ab.y()));
+        views.push_back(cell_direction(o.grid, cell, ab.x(), ab.y()));
         lights_of.push_back(std::uint32_t(l));
       }
       sums[std::size_t(column)] +=
@@ -384,8 +392,9 @@ void SlfBakeOptions::validate() const {
   grid.validate();
   if (spp < 1 || spp > kMaxSpp)
     throw std::invalid_argument("--spp must be in [1, 65536], got " + std::to_string(spp));
-  if (light_samples < 0 || light_samples > 4096)
-    throw std::invalid_argument("--light-samples must be in [0, 4096], got " +
+  if (light_samples < 0 || light_samples > kMaxLightSamples)
+    throw std::invalid_argument("--light-samples must be in [0, " +
+                                std::to_string(kMaxLightSamples) + "], got " +
                                 std::to_string(light_samples));
   PathTracerOptions tracer;
   tracer.bounces = bounces;

@@ -49,6 +49,7 @@
 namespace prt {
 
 inline constexpr std::uint32_t kSlfFileVersion = 3;
+inline constexpr int kMaxLightSamples = 4096;  // SlfBakeOptions::light_samples
 
 class SlfFileError : public std::runtime_error {
  public:
@@ -60,7 +61,7 @@ struct SlfBakeOptions {
   int spp = 16;  // samples per texel and direction, in [1, 65536]
   // > 0: each path's first light sample is this many probe samples shared by all the
   // texel's paths (prt::SharedLights; light_samples x spp shadow rays a texel, the same for
-  // every cell); 0: each path draws and traces its own. In [0, 4096].
+  // every cell); 0: each path draws and traces its own. In [0, kMaxLightSamples].
   int light_samples = 4;
   int bounces = 1;  // interreflections (prt/path_tracer.h)
   std::uint64_t seed = 1;
