@@ -1,17 +1,24 @@
-// slf_bench [--mesh M] [--frames F] [--width W] [--height H] [--map X] [--components k]
-// [--clusters eta] [--azimuth Z] [--elevation W] [--gl osmesa|egl] [--gl-device N]: the
-// one-pass surface light field renderer (render/slf_renderer.h) against the trivial-shader
-// floor (render/floor_harness.h) on the same mesh, camera and framebuffer, in one run so the
-// ratio is fair. Defaults: the Stanford bunny at 1280 x 948, k = 8, eta = 256, Z x W =
-// 32 x 16 (the SLF paper's specular setting, with its direction grid), a 1024 x 1024 surface
-// map. The model is synthetic (the bake's output is not needed to time the reconstruction):
-// a chart per triangle, clusters in spatially coherent patches (the bunny's directions from
-// its centre on a 16 x 16 lat-long grid, so most fragments see four texels of one cluster and
-// the patch borders see several, as after CPCA), random weights and view maps. Rows: with
-// the probe background (against the floor with the same background pass) and without; the
-// shared-cluster fast path on and off; wall clock and process CPU per frame (the load of a
-// shared machine inflates the first far more).
+// slf_bench [--mesh M] [--frames F] [--rounds R] [--width W] [--height H] [--charts
+// conformal|per-triangle]
+// [--map X] [--components k] [--clusters eta] [--azimuth Z] [--elevation W]
+// [--gl osmesa|egl] [--gl-device N]: the surface light field renderer
+// (render/slf_renderer.h) against the trivial-shader floor (render/floor_harness.h) on the
+// same mesh, camera and framebuffer, in one run so the ratio is fair. Defaults: the Stanford
+// bunny at 1280 x 948, k = 8, eta = 256, Z x W = 32 x 16 (the SLF paper's specular setting,
+// with its direction grid), the 256 x 256 conformal atlas `prtr slf` makes by default. The
+// model is synthetic (the bake's output is not needed to time the reconstruction): clusters
+// in spatially coherent patches (the bunny's directions from its centre on a 16 x 16
+// lat-long grid, so most fragments see four texels of one cluster and the patch borders see
+// several, as after CPCA), random weights and view maps. `--charts per-triangle` makes a
+// chart per triangle instead (`--map 1024` holds the bunny's). Rows: each shading
+// (one pass, deferred, texture space, and the automatic choice) with the probe background
+// (against the floor with the same background pass) and without; the shared-cluster fast
+// path on and off; wall clock and process CPU per frame (the load of a shared machine
+// inflates the first far more). Every row is timed once a round, between the floors of
+// that round, over R rounds (default 5); a ratio is the median over rounds of the row's
+// time over its round's floor, so a drift of the machine's speed does not enter it.
 #include "bench_probe.h"
+#include "meshes/atlas.h"
 #include "meshes/load.h"
 #include "render/camera.h"
 #include "render/floor_harness.h"
@@ -39,7 +46,8 @@ struct UsageError : std::runtime_error {
 struct Args {
   std::string mesh = "/usr/share/glmark2/models/bunny.obj";
   render::GlSelection gl;
-  int frames = 15, width = 1280, height = 948, map = 1024;
+  meshes::AtlasCharts charts = meshes::AtlasCharts::kConformal;
+  int frames = 10, rounds = 5, width = 1280, height = 948, map = 256;
   int components = 8, clusters = 256, azimuth = 32, elevation = 16;
 };
 
@@ -73,10 +81,18 @@ Args parse_args(int argc, char** argv) {
       a.gl.device = parse_int(flag, value, 0, 1000);
     } else if (flag == "--frames") {
       a.frames = parse_int(flag, value, 1, 10000);
+    } else if (flag == "--rounds") {
+      a.rounds = parse_int(flag, value, 1, 1000);
     } else if (flag == "--width") {
       a.width = parse_int(flag, value, 1, 16384);
     } else if (flag == "--height") {
       a.height = parse_int(flag, value, 1, 16384);
+    } else if (flag == "--charts") {
+      try {
+        a.charts = meshes::kAtlasChartsNames.parse(value);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError("--charts: " + std::string(e.what()));
+      }
     } else if (flag == "--map") {
       a.map = parse_int(flag, value, 16, 16384);
     } else if (flag == "--components") {
@@ -94,63 +110,109 @@ Args parse_args(int argc, char** argv) {
   return a;
 }
 
+// Clusters in patches by direction from the mesh's centre; random weights and view maps.
+struct Synthetic {
+  const Args& a;
+  Eigen::Vector3f centre;
+  int side;
+  std::mt19937 rng{1};
+  std::uniform_real_distribution<float> weight{-0.5f, 0.5f};
+
+  Synthetic(const meshes::Mesh& mesh, const Args& args)
+      : a(args),
+        centre(meshes::bounds(mesh).center()),
+        side(std::max(1, int(std::round(std::sqrt(double(args.clusters)))))) {}
+
+  int cluster_of(const Eigen::Vector3f& p) const {
+    const Eigen::Vector3f d = (p - centre).normalized();
+    const double u = (std::atan2(d.x(), d.z()) / std::numbers::pi + 1.0) * 0.5;
+    const double v = std::acos(std::clamp(double(d.y()), -1.0, 1.0)) / std::numbers::pi;
+    const int i = std::min(side - 1, int(u * side)), j = std::min(side - 1, int(v * side));
+    return (j * side + i) % a.clusters;
+  }
+  // Texel `texel` samples point p.
+  void use_texel(render::SlfModel& m, std::size_t texel, const Eigen::Vector3f& p) {
+    m.texel_cluster[texel] = cluster_of(p);
+    m.texel_positions[texel] = p;
+    for (int j = 0; j < a.components; ++j)
+      m.texel_weights[texel * std::size_t(a.components) + std::size_t(j)] = weight(rng);
+  }
+};
+
+render::SlfModel empty_model(const meshes::Mesh& mesh, const Args& a) {
+  render::SlfModel m;
+  m.map_width = m.map_height = a.map;
+  m.grid = {a.azimuth, a.elevation};
+  m.components = a.components;
+  m.clusters = a.clusters;
+  const std::size_t texels = std::size_t(a.map) * std::size_t(a.map);
+  m.texel_cluster.assign(texels, -1);
+  m.texel_weights.assign(texels * std::size_t(a.components), 0.f);
+  m.texel_positions.assign(texels, Eigen::Vector3f::Zero());
+  for (const auto& tri : mesh.triangles) {
+    const Eigen::Vector3f p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]],
+                          p2 = mesh.positions[tri[2]];
+    const Eigen::Vector3f normal = (p1 - p0).cross(p2 - p0).normalized();
+    for (const Eigen::Vector3f& p : {p0, p1, p2}) {
+      m.positions.push_back(p);
+      m.normals.push_back(normal);
+    }
+  }
+  return m;
+}
+
 // A chart per triangle: an n x n cell of the map, the triangle's corners at texels (1, 1),
 // (n - 1, 1) and (1, n - 1) of it, so a lookup inside reads only its own cell's texels.
-// Each texel of a used cell takes the cluster of the surface point its position in the
-// cell extrapolates to; unused cells are -1.
-render::SlfModel synthetic_model(const meshes::Mesh& mesh, const Args& a) {
+// Each texel of a used cell samples the surface point its position in the cell
+// extrapolates to; unused cells are -1.
+void per_triangle_charts(render::SlfModel& m, const meshes::Mesh& mesh, Synthetic& synthetic) {
+  const Args& a = synthetic.a;
   const int triangles = int(mesh.triangle_count());
   const int n = std::max(3, int(std::floor(a.map / std::ceil(std::sqrt(double(triangles))))));
   const int per_row = a.map / n;
   if (per_row * per_row < triangles)
     throw UsageError("--map " + std::to_string(a.map) + " is too small for " +
                      std::to_string(triangles) + " triangles");
-  render::SlfModel m;
-  m.map_width = m.map_height = a.map;
-  m.grid = {a.azimuth, a.elevation};
-  m.components = a.components;
-  m.clusters = a.clusters;
-  m.texel_cluster.assign(std::size_t(a.map) * a.map, -1);
-  m.texel_weights.assign(m.texel_cluster.size() * std::size_t(a.components), 0.f);
-  const meshes::Bounds b = meshes::bounds(mesh);
-  const Eigen::Vector3f centre = b.center();
-  const int side = std::max(1, int(std::round(std::sqrt(double(a.clusters)))));
-  auto cluster_of = [&](const Eigen::Vector3f& p) {
-    const Eigen::Vector3f d = (p - centre).normalized();
-    const double u = (std::atan2(d.x(), d.z()) / std::numbers::pi + 1.0) * 0.5;
-    const double v = std::acos(std::clamp(double(d.y()), -1.0, 1.0)) / std::numbers::pi;
-    const int i = std::min(side - 1, int(u * side)), j = std::min(side - 1, int(v * side));
-    return (j * side + i) % a.clusters;
-  };
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<float> weight(-0.5f, 0.5f);
   const float scale = 1.f / float(a.map);
   for (int t = 0; t < triangles; ++t) {
     const int cx = (t % per_row) * n, cy = (t / per_row) * n;
     const Eigen::Vector2f c0(float(cx + 1), float(cy + 1)), c1(float(cx + n - 1), float(cy + 1)),
         c2(float(cx + 1), float(cy + n - 1));
-    const auto& tri = mesh.triangles[std::size_t(t)];
-    const Eigen::Vector3f p0 = mesh.positions[tri[0]], p1 = mesh.positions[tri[1]],
-                          p2 = mesh.positions[tri[2]];
-    const Eigen::Vector3f normal = (p1 - p0).cross(p2 - p0).normalized();
     for (const Eigen::Vector2f& c : {c0, c1, c2}) m.uv.push_back(c * scale);
-    for (const Eigen::Vector3f& p : {p0, p1, p2}) {
-      m.positions.push_back(p);
-      m.normals.push_back(normal);
-    }
+    const Eigen::Vector3f p0 = m.positions[3 * std::size_t(t)],
+                          p1 = m.positions[3 * std::size_t(t) + 1],
+                          p2 = m.positions[3 * std::size_t(t) + 2];
     for (int y = cy; y < cy + n; ++y)
       for (int x = cx; x < cx + n; ++x) {
         const float u = (float(x) + 0.5f - c0.x()) / float(n - 2);
         const float v = (float(y) + 0.5f - c0.y()) / float(n - 2);
-        const std::size_t texel = std::size_t(y) * std::size_t(a.map) + std::size_t(x);
-        m.texel_cluster[texel] = cluster_of((1 - u - v) * p0 + u * p1 + v * p2);
-        for (int j = 0; j < a.components; ++j)
-          m.texel_weights[texel * std::size_t(a.components) + std::size_t(j)] = weight(rng);
+        synthetic.use_texel(m, std::size_t(y) * std::size_t(a.map) + std::size_t(x),
+                            (1 - u - v) * p0 + u * p1 + v * p2);
       }
+  }
+}
+
+render::SlfModel synthetic_model(const meshes::Mesh& mesh, const Args& a) {
+  render::SlfModel m = empty_model(mesh, a);
+  Synthetic synthetic(mesh, a);
+  if (a.charts == meshes::AtlasCharts::kPerTriangle) {
+    per_triangle_charts(m, mesh, synthetic);
+  } else {
+    const meshes::Atlas atlas = meshes::make_atlas(mesh, a.map, a.map, {a.charts});
+    m.uv = atlas.uv;
+    for (std::size_t texel = 0; texel < atlas.texel_triangle.size(); ++texel) {
+      const std::int32_t t = atlas.texel_triangle[texel];
+      if (t < 0) continue;
+      const Eigen::Vector2f b = atlas.texel_barycentric[texel];
+      const std::size_t c = 3 * std::size_t(t);
+      synthetic.use_texel(m, texel,
+                          (1 - b.x() - b.y()) * m.positions[c] + b.x() * m.positions[c + 1] +
+                              b.y() * m.positions[c + 2]);
+    }
   }
   std::uniform_real_distribution<float> view(0.f, 1.f);
   m.view_maps.resize(std::size_t(a.clusters) * std::size_t(a.components + 1) * m.slice_floats());
-  for (float& value : m.view_maps) value = view(rng);
+  for (float& value : m.view_maps) value = view(synthetic.rng);
   m.validate();
   return m;
 }
@@ -220,52 +282,80 @@ int main(int argc, char** argv) {
         render::frame_sphere(b.center().cast<double>(), 0.5 * b.diagonal(), a.width, a.height);
     std::printf(
         "%s, %s: %zu triangles, %d x %d map, k = %d, eta = %d, %d x %d directions, "
-        "%d x %d, median of %d frames\n",
+        "%d x %d, median of %d frames, %d rounds\n",
         context.description().c_str(), context.info().renderer.c_str(), mesh.triangle_count(),
-        a.map, a.map, a.components, a.clusters, a.azimuth, a.elevation, a.width, a.height,
-        a.frames);
+        a.map, a.map, a.components, a.clusters, a.azimuth, a.elevation, a.width, a.height, a.frames,
+        a.rounds);
 
     render::SlfRenderer renderer(model, &probe);
-    const Row floor_bg = time_floor(mesh, camera, a.frames, &probe);
-    const Row floor = time_floor(mesh, camera, a.frames, nullptr);
     render::Background with_probe;
     render::Background solid;
     solid.use_probe = false;
-    renderer.set_background(with_probe);
-    const Row slf_bg = time_slf(renderer, camera, a.frames);
-    renderer.set_background(solid);
-    const Row slf = time_slf(renderer, camera, a.frames);
-    renderer.set_options({true, false, false});
-    const Row slf_four = time_slf(renderer, camera, a.frames);
-    renderer.set_options({true, true, true});
-    const Row slf_deferred = time_slf(renderer, camera, a.frames);
-    renderer.set_background(with_probe);
-    const Row slf_deferred_bg = time_slf(renderer, camera, a.frames);
-    renderer.set_options({true, true, false});
-    // The floor again at the end: a shared machine's load drifts during a run.
-    const Row floor_bg_late = time_floor(mesh, camera, a.frames, &probe);
+    using render::SlfShading;
+    struct Timed {
+      std::string name;
+      SlfShading shading;
+      bool shared;
+      bool background;
+      std::vector<Row> rounds{};
+    };
+    std::vector<Timed> rows;
+    for (bool background : {true, false}) {
+      rows.push_back({"one pass", SlfShading::kOnePass, true, background});
+      rows.push_back({"deferred (uv pre-pass)", SlfShading::kDeferred, true, background});
+      rows.push_back({"texture space", SlfShading::kTextureSpace, true, background});
+      rows.push_back({"automatic", SlfShading::kAutomatic, true, background});
+    }
+    rows.push_back({"one pass, four texels everywhere", SlfShading::kOnePass, false, false});
+    std::vector<Row> floors_bg, floors;
+    SlfShading chosen = SlfShading::kAutomatic;
+    long long texels_shaded = 0;
+    for (int round = 0; round < a.rounds; ++round) {
+      floors_bg.push_back(time_floor(mesh, camera, a.frames, &probe));
+      floors.push_back(time_floor(mesh, camera, a.frames, nullptr));
+      for (Timed& row : rows) {
+        renderer.set_options({true, row.shared, row.shading});
+        renderer.set_background(row.background ? with_probe : solid);
+        row.rounds.push_back(time_slf(renderer, camera, a.frames));
+        if (row.shading == SlfShading::kAutomatic) chosen = renderer.shading();
+        if (row.shading == SlfShading::kTextureSpace) texels_shaded = renderer.texels_shaded();
+      }
+    }
 
-    auto print = [](const char* name, const Row& r, const Row& base) {
-      std::printf("  %-44s %8.2f ms = %5.2f x floor   CPU %8.2f ms = %5.2f x floor\n", name,
-                  r.frame_ms, r.frame_ms / base.frame_ms, r.cpu_ms, r.cpu_ms / base.cpu_ms);
+    // Medians over rounds: of the times, and of each round's ratio to its own floor.
+    auto print = [&](const std::string& name, const std::vector<Row>& r,
+                     const std::vector<Row>& base) {
+      std::vector<double> wall, cpu, wall_ratio, cpu_ratio;
+      for (std::size_t i = 0; i < r.size(); ++i) {
+        wall.push_back(r[i].frame_ms);
+        cpu.push_back(r[i].cpu_ms);
+        wall_ratio.push_back(r[i].frame_ms / base[i].frame_ms);
+        cpu_ratio.push_back(r[i].cpu_ms / base[i].cpu_ms);
+      }
+      std::printf("  %-44s %8.2f ms = %5.2f x floor   CPU %8.2f ms = %5.2f x floor\n", name.c_str(),
+                  median(wall), median(wall_ratio), median(cpu), median(cpu_ratio));
+      return median(wall_ratio);
     };
     std::printf("\nwith the probe background (floor: background pass + trivial mesh):\n");
-    print("floor + background", floor_bg, floor_bg);
-    print("floor + background (again, at the end)", floor_bg_late, floor_bg);
-    print("SLF one pass + background", slf_bg, floor_bg);
-    print("SLF deferred (uv pre-pass) + background", slf_deferred_bg, floor_bg);
+    print("floor + background", floors_bg, floors_bg);
+    double automatic = 0;
+    for (const Timed& row : rows)
+      if (row.background) {
+        const double ratio = print("SLF " + row.name + " + background", row.rounds, floors_bg);
+        if (row.shading == SlfShading::kAutomatic) automatic = ratio;
+      }
     std::printf("\nsolid background (floor: clear + trivial mesh):\n");
-    print("floor", floor, floor);
-    print("SLF one pass", slf, floor);
-    print("SLF one pass, four texels everywhere", slf_four, floor);
-    print("SLF deferred (uv pre-pass)", slf_deferred, floor);
+    print("floor", floors, floors);
+    for (const Timed& row : rows)
+      if (!row.background) print("SLF " + row.name, row.rounds, floors);
     std::printf(
-        "\ntarget: SLF + background <= 2 x floor + background: one pass %.2f (%s), "
-        "deferred %.2f (%s)\n",
-        slf_bg.frame_ms / floor_bg.frame_ms,
-        slf_bg.frame_ms <= 2 * floor_bg.frame_ms ? "met" : "not met",
-        slf_deferred_bg.frame_ms / floor_bg.frame_ms,
-        slf_deferred_bg.frame_ms <= 2 * floor_bg.frame_ms ? "met" : "not met");
+        "\ntexture space shades %lld texels a frame (%.0f%% of the %lld in blocks that "
+        "triangles read)\n",
+        texels_shaded, 100.0 * double(texels_shaded) / double(renderer.texels_in_blocks()),
+        renderer.texels_in_blocks());
+    std::printf("\ntarget: SLF + background <= 2 x floor + background: automatic (%s) %.2f (%s)\n",
+                render::kSlfShadingNames.name(chosen), automatic,
+                automatic <= 2 ? "met" : "not met");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "slf_bench: %s\n", e.what());
     return 1;

@@ -6,6 +6,8 @@
 #include "render/slf_reference.h"
 #include "render/slf_renderer.h"
 
+#include "meshes/atlas.h"
+#include "meshes/procedural.h"
 #include "probes/procedural.h"
 #include "render/gl_context.h"
 #include "render/supersample.h"
@@ -57,6 +59,7 @@ void fill_maps(render::SlfModel& m, const ClusterOf& cluster, const WeightOf& we
       m.texel_cluster[t] = cluster(x, y);
       for (int j = 0; j < k; ++j) m.texel_weights[t * k + j] = weight(x, y, j);
     }
+  m.texel_positions = render::texel_points_from_uv(m);
   m.view_maps.resize(std::size_t(m.clusters) * (k + 1) * m.slice_floats());
   for (int c = 0; c < m.clusters; ++c)
     for (int s = 0; s <= k; ++s)
@@ -129,6 +132,8 @@ TEST(SlfModel, ValidateRefusesEachInconsistentSize) {
       {"texel_cluster", [](M& m) { m.texel_cluster.pop_back(); }},
       {"texel_weights", [](M& m) { m.texel_weights.push_back(0.f); }},
       {"view_maps", [](M& m) { m.view_maps.pop_back(); }},
+      {"texel_positions", [](M& m) { m.texel_positions.pop_back(); }},
+      {"texel_positions[3]", [](M& m) { m.texel_positions[3].y() = INFINITY; }},
       // The arrays sized for other k, X or eta.
       {"texel_weights", [](M& m) { m.components = 3; }},
       {"texel_cluster", [](M& m) { m.map_height = 4; }},
@@ -402,6 +407,14 @@ Comparison compare(const render::Image& gl, const render::Image& cpu, double tol
 constexpr double kImageTolerance = 1e-4;
 constexpr int kEdgePixels = 12;
 
+// Every way to shade; the screen paths with and without the shared-cluster fast path
+// (texture space reconstructs each texel alone and ignores it).
+const std::pair<render::SlfShading, bool> kVariants[] = {{render::SlfShading::kOnePass, true},
+                                                         {render::SlfShading::kOnePass, false},
+                                                         {render::SlfShading::kDeferred, true},
+                                                         {render::SlfShading::kDeferred, false},
+                                                         {render::SlfShading::kTextureSpace, true}};
+
 TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnEveryPathAndAtThePoles) {
   render::GlContext ctx;
   const render::SlfModel model = scene_model();
@@ -423,17 +436,21 @@ TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnEveryPathAndAtThePoles) {
   background.colour = render::Rgb(0.1f, 0.2f, 0.3f);
   for (const render::Camera& camera : {front, above}) {
     const render::Image cpu = render::render_slf_reference(model, camera, reference_options);
-    for (int variant = 0; variant < 4; ++variant) {
-      const bool fast = variant % 2 == 0, deferred = variant >= 2;
+    render::SlfReferenceOptions per_texel = reference_options;
+    per_texel.texel_directions = true;
+    const render::Image cpu_per_texel = render::render_slf_reference(model, camera, per_texel);
+    for (const auto& [shading, fast] : kVariants) {
       render::GlDebugLog log;
-      render::SlfRenderer renderer(model, nullptr, {true, fast, deferred});
+      render::SlfRenderer renderer(model, nullptr, {true, fast, shading});
       renderer.set_background(background);
       renderer.render(camera);
+      EXPECT_EQ(renderer.shading(), shading);
       const render::Image gl = renderer.read_image();
-      const Comparison c = compare(gl, cpu, kImageTolerance);
+      const bool texel_space = shading == render::SlfShading::kTextureSpace;
+      const Comparison c = compare(gl, texel_space ? cpu_per_texel : cpu, kImageTolerance);
       const std::string label = std::string(camera.eye.y() > 1 ? "above" : "front") +
                                 (fast ? ", shared-cluster path" : ", four texels everywhere") +
-                                (deferred ? ", deferred" : ", one pass");
+                                ", " + render::kSlfShadingNames.name(shading);
       EXPECT_GT(c.covered, camera.width * camera.height / 4) << label;
       EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels)
           << label << " (worst of the others " << c.worst << ")";
@@ -475,19 +492,25 @@ TEST(SlfRenderer, NegativeReconstructionRendersClampedOnBothPaths) {
   EXPECT_EQ(on_cpu.negative, 0);
   EXPECT_GT(on_cpu.zero_red, on_cpu.covered / 10);
   EXPECT_LT(on_cpu.zero_red, on_cpu.covered * 9 / 10);
+  render::SlfReferenceOptions per_texel;
+  per_texel.texel_directions = true;
+  const render::Image cpu_per_texel = render::render_slf_reference(model, camera, per_texel);
   render::Background background;
   background.use_probe = false;
-  for (int variant = 0; variant < 4; ++variant) {
-    const bool fast = variant % 2 == 0, deferred = variant >= 2;
-    render::SlfRenderer renderer(model, nullptr, {true, fast, deferred});
+  for (const auto& [shading, fast] : kVariants) {
+    const std::string variant =
+        std::string(render::kSlfShadingNames.name(shading)) + (fast ? "" : ", four texels");
+    render::SlfRenderer renderer(model, nullptr, {true, fast, shading});
     renderer.set_background(background);
     renderer.render(camera);
     const render::Image gl = renderer.read_image();
+    const render::Image& reference =
+        shading == render::SlfShading::kTextureSpace ? cpu_per_texel : cpu;
     const Counts on_gl = count(gl);
-    EXPECT_EQ(on_gl.negative, 0) << "variant " << variant;
-    EXPECT_NEAR(on_gl.zero_red, on_cpu.zero_red, kEdgePixels) << "variant " << variant;
-    const Comparison c = compare(gl, cpu, kImageTolerance);
-    EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels) << "variant " << variant;
+    EXPECT_EQ(on_gl.negative, 0) << variant;
+    EXPECT_NEAR(on_gl.zero_red, count(reference).zero_red, kEdgePixels) << variant;
+    const Comparison c = compare(gl, reference, kImageTolerance);
+    EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels) << variant;
   }
 }
 
@@ -499,14 +522,18 @@ TEST(SlfRenderer, BackFacesAreCulledLikeTheReference) {
   behind.eye = {0.1, 0.2, -3.0};
   behind.width = 40;
   behind.height = 30;
-  for (int variant = 0; variant < 4; ++variant) {
-    const bool cull = variant % 2 == 0, deferred = variant >= 2;
-    render::SlfRenderer renderer(model, nullptr, {cull, true, deferred});
+  for (int variant = 0; variant < 6; ++variant) {
+    const bool cull = variant % 2 == 0;
+    const render::SlfShading shading = variant < 2   ? render::SlfShading::kOnePass
+                                       : variant < 4 ? render::SlfShading::kDeferred
+                                                     : render::SlfShading::kTextureSpace;
+    render::SlfRenderer renderer(model, nullptr, {cull, true, shading});
     render::Background background;
     background.use_probe = false;
     renderer.set_background(background);
     renderer.render(behind);
-    const render::Image cpu = render::render_slf_reference(model, behind, {cull, Vector3f::Zero()});
+    const render::Image cpu = render::render_slf_reference(
+        model, behind, {cull, Vector3f::Zero(), shading == render::SlfShading::kTextureSpace});
     const Comparison c = compare(renderer.read_image(), cpu, kImageTolerance);
     EXPECT_EQ(c.covered > 0, !cull);
     EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels);
@@ -555,18 +582,201 @@ TEST(SlfRenderer, SupersampledImageIsTheFilteredLargeReference) {
   render::Camera camera;
   camera.width = 30;
   camera.height = 22;
+  for (const render::SlfShading shading :
+       {render::SlfShading::kOnePass, render::SlfShading::kTextureSpace}) {
+    render::SlfImageOptions o;
+    o.supersample = 2;
+    o.renderer.shading = shading;
+    const render::Image gl = render::render_slf_image(model, camera, nullptr, o);
+    ASSERT_EQ(gl.width, 30);
+    render::SlfReferenceOptions r;
+    r.texel_directions = shading == render::SlfShading::kTextureSpace;
+    const render::Image cpu = render::box_downsample(
+        render::render_slf_reference(model, render::supersampled(camera, 2), r), 2);
+    // A pixel that one renderer covers at one more subsample than the other differs by a
+    // quarter of its radiance: few, on the outlines.
+    const Comparison c = compare(gl, cpu, kImageTolerance);
+    EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels);
+  }
   render::SlfImageOptions o;
-  o.supersample = 2;
-  const render::Image gl = render::render_slf_image(model, camera, nullptr, o);
-  ASSERT_EQ(gl.width, 30);
-  const render::Image cpu = render::box_downsample(
-      render::render_slf_reference(model, render::supersampled(camera, 2)), 2);
-  // A pixel that one renderer covers at one more subsample than the other differs by a
-  // quarter of its radiance: few, on the outlines.
-  const Comparison c = compare(gl, cpu, kImageTolerance);
-  EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels);
   EXPECT_THROW(render::render_slf_image(model, camera, nullptr, {{}, {}, 0}),
                std::invalid_argument);
+}
+
+// --- Texture space ---------------------------------------------------------------------------
+
+// A closed mesh on its conformal atlas: a sphere of 2,048 triangles on a 128 x 128 map, clusters
+// in patches over the sphere, weights varying over the surface, view maps smooth in
+// direction and different per cluster.
+render::SlfModel sphere_model() {
+  constexpr int kSide = 128;
+  const meshes::Mesh mesh = meshes::make_sphere(1.f, 32, 32);
+  const meshes::Atlas atlas = meshes::make_atlas(mesh, kSide, kSide);
+  render::SlfModel m;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+    for (std::uint32_t v : mesh.triangles[t]) {
+      m.positions.push_back(mesh.positions[v]);
+      m.normals.push_back(mesh.positions[v].normalized());
+    }
+  m.uv = atlas.uv;
+  m.map_width = m.map_height = kSide;
+  m.grid = {12, 6};
+  m.components = 3;
+  m.clusters = 6;
+  m.texel_positions.assign(kSide * kSide, Vector3f::Zero());
+  for (std::size_t texel = 0; texel < m.texel_positions.size(); ++texel) {
+    const std::int32_t t = atlas.texel_triangle[texel];
+    if (t < 0) continue;
+    const Vector2f b = atlas.texel_barycentric[texel];
+    const std::size_t c = 3 * std::size_t(t);
+    m.texel_positions[texel] = (1 - b.x() - b.y()) * m.positions[c] + b.x() * m.positions[c + 1] +
+                               b.y() * m.positions[c + 2];
+  }
+  const std::vector<Vector3f> points = m.texel_positions;
+  fill_maps(
+      m,
+      [&](int x, int y) {
+        const std::size_t t = std::size_t(y) * kSide + std::size_t(x);
+        if (atlas.texel_triangle[t] < 0) return -1;
+        const Vector3f p = points[t];
+        return (p.x() > 0) + 2 * (p.y() > 0.3f) + 2 * (p.y() > -0.3f);
+      },
+      [&](int x, int y, int j) {
+        const Vector3f p = points[std::size_t(y) * kSide + std::size_t(x)];
+        return float(0.3 * std::sin(2.0 * p.x() + j) + 0.2 * std::cos(3.0 * p.z() - j));
+      },
+      [](int c, int s, int i, int j, int ch) {
+        const double a = 2 * std::numbers::pi * (i + 0.5) / 12, p = (j + 0.5) / 6;
+        return float((s == 0 ? 1.0 + 0.1 * c : 0.3) *
+                     (1.0 + 0.4 * std::sin(a + c + s + ch) + 0.3 * p * (ch + 1)));
+      });
+  m.texel_positions = points;  // the atlas's sample points, not fill_maps' guess from uv
+  m.validate();
+  return m;
+}
+
+// The texels each texel shades are those its own triangle reads: seen from outside, about
+// half the sphere's blocks face away and are skipped, yet every frame matches the reference,
+// including frames after another viewpoint left the radiance map holding other texels, and
+// a close-up whose frustum holds only part of the sphere.
+TEST(SlfRenderer, TextureSpaceShadesOnlyTheBlocksInViewAndMissesNone) {
+  render::GlContext ctx;
+  const render::SlfModel model = sphere_model();
+  render::SlfRenderer renderer(model, nullptr, {true, true, render::SlfShading::kTextureSpace});
+  render::Background background;
+  background.use_probe = false;
+  renderer.set_background(background);
+  render::SlfReferenceOptions per_texel;
+  per_texel.texel_directions = true;
+  render::Camera camera;
+  camera.width = 80;
+  camera.height = 60;
+  camera.near_plane = 0.1;
+  camera.far_plane = 20;
+  const Vector3d eyes[] = {{0.3, 0.2, 3.5}, {-3.2, 1.0, -0.8}, {0.4, -3.4, 0.5}, {0.9, 0.5, 1.2}};
+  for (const Vector3d& eye : eyes) {
+    camera.eye = eye;
+    renderer.render(camera);
+    const long long shaded = renderer.texels_shaded();
+    EXPECT_GT(shaded, 0);
+    EXPECT_LT(shaded, renderer.texels_in_blocks() * 65 / 100) << eye.transpose();
+    const Comparison c =
+        compare(renderer.read_image(), render::render_slf_reference(model, camera, per_texel),
+                kImageTolerance);
+    EXPECT_GT(c.covered, 200) << eye.transpose();
+    EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels)
+        << eye.transpose() << " (worst of the others " << c.worst << ")";
+  }
+}
+
+// Texture space and the fragment's own direction differ by the angle a texel subtends at the
+// eye: on the sphere from 3.5 away that is well under a percent of the radiance.
+TEST(SlfRenderer, TextureSpaceIsCloseToTheFragmentsOwnDirection) {
+  render::GlContext ctx;
+  const render::SlfModel model = sphere_model();
+  render::Camera camera;
+  camera.eye = {0.3, 0.2, 3.5};
+  camera.width = 80;
+  camera.height = 60;
+  const render::Image per_fragment = render::render_slf_reference(model, camera);
+  render::SlfImageOptions o;
+  o.renderer.shading = render::SlfShading::kTextureSpace;
+  const Comparison c =
+      compare(render::render_slf_image(model, camera, nullptr, o), per_fragment, 0.01);
+  EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels);
+  EXPECT_GT(c.worst, kImageTolerance);  // they are not the same function
+}
+
+// The automatic choice shades in texture space when a frame covers more pixels than the
+// blocks in view hold texels, and on the screen when it covers fewer.
+TEST(SlfRenderer, AutomaticShadingFollowsTheCostOfEachPath) {
+  render::GlContext ctx;
+  const render::SlfModel model = sphere_model();
+  render::SlfRenderer renderer(model, nullptr);
+  render::Camera camera;
+  camera.eye = {0.3, 0.2, 3.5};
+  camera.width = 320;
+  camera.height = 240;
+  for (int frame = 0; frame < 2; ++frame) {
+    renderer.render(camera);
+    EXPECT_EQ(renderer.shading(), render::SlfShading::kTextureSpace) << frame;
+  }
+  camera.width = 24;
+  camera.height = 18;
+  for (int frame = 0; frame < 2; ++frame) {
+    renderer.render(camera);
+    EXPECT_NE(renderer.shading(), render::SlfShading::kTextureSpace) << frame;
+  }
+}
+
+// The CPU reference's per-texel directions: at a texel centre the texel alone, toward the
+// eye from its own point; between centres the bilinear blend of the four, each so.
+TEST(SlfReference, TexelDirectionsBlendEachTexelTowardTheEye) {
+  const render::SlfModel m = sphere_model();
+  const Vector3d eye(0.4, 1.5, 2.5);
+  const int side = m.map_width;
+  for (int x : {20, 33, 47, 70, 101})
+    for (int y : {12, 30, 51, 88, 113}) {
+      const std::size_t t = std::size_t(y) * side + std::size_t(x);
+      if (m.texel_cluster[t] < 0) continue;
+      const Vector2f centre((x + 0.5f) / side, (y + 0.5f) / side);
+      const Vector3f toward = render::slf_radiance_toward(m, centre, eye);
+      const Vector3f expected =
+          render::slf_radiance(m, centre, eye - m.texel_positions[t].cast<double>());
+      EXPECT_LT((toward - expected).norm(), 1e-6 * expected.norm()) << x << ", " << y;
+      // A quarter of the way to the next texel in x and y.
+      const Vector2f between((x + 0.75f) / side, (y + 0.75f) / side);
+      Eigen::Vector3d blend = Eigen::Vector3d::Zero();
+      for (int b = 0; b < 2; ++b)
+        for (int a = 0; a < 2; ++a) {
+          const std::size_t u = std::size_t(y + b) * side + std::size_t(x + a);
+          if (m.texel_cluster[u] < 0) continue;
+          const Vector2f c((x + a + 0.5f) / side, (y + b + 0.5f) / side);
+          blend +=
+              (a ? 0.25 : 0.75) * (b ? 0.25 : 0.75) *
+              render::slf_radiance(m, c, eye - m.texel_positions[u].cast<double>()).cast<double>();
+        }
+      EXPECT_LT((render::slf_radiance_toward(m, between, eye).cast<double>() - blend).norm(),
+                1e-5 * blend.norm())
+          << x << ", " << y;
+    }
+}
+
+// A texel's point is where its centre falls on the surface: on a flat square mapped
+// linearly over [0, 1]^2, (2u - 1, 2v - 1, 0).
+TEST(SlfModel, TexelPointsFromUvAreTheSurfaceUnderEachCentre) {
+  render::SlfModel m = one_quad_model(8, 6, {4, 2}, 0, 1);
+  m.texel_cluster.assign(48, 0);
+  m.texel_cluster[9] = -1;
+  const std::vector<Vector3f> points = render::texel_points_from_uv(m);
+  ASSERT_EQ(points.size(), 48u);
+  for (int y = 0; y < 6; ++y)
+    for (int x = 0; x < 8; ++x) {
+      const std::size_t t = std::size_t(y) * 8 + std::size_t(x);
+      const Vector3f expected =
+          t == 9 ? Vector3f::Zero() : Vector3f(2 * (x + 0.5f) / 8 - 1, 2 * (y + 0.5f) / 6 - 1, 0);
+      EXPECT_LT((points[t] - expected).norm(), 1e-5) << x << ", " << y;
+    }
 }
 
 }  // namespace

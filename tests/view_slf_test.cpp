@@ -58,8 +58,9 @@ const Baked& baked() {
 
 const Eigen::Vector3f kBackground(0.1f, 0.2f, 0.3f);
 
-viewer::SlfSceneInputs inputs() {
+viewer::SlfSceneInputs inputs(render::SlfShading shading) {
   viewer::SlfSceneInputs in;
+  in.shading = shading;
   in.mesh = &baked().mesh;
   in.model = &baked().model;
   in.probe = &baked().probe;
@@ -107,8 +108,9 @@ constexpr int kEdgePixels = 24;
 
 // Placement eye (0, 0, 4) looking at the origin; cam_yaw turns it about +Y (right-handed) and
 // zoom divides its distance: yaw 90 and zoom 1.25 put it at (3.2, 0, 0).
+// Texture space here (the reference with each texel's own direction), one pass below.
 TEST(ViewSlfScene, FrameIsTheReferenceFromTheOrbitedCamera) {
-  viewer::SlfScene scene(inputs());
+  viewer::SlfScene scene(inputs(render::SlfShading::kTextureSpace));
   ViewState s;
   s.width = 64;
   s.height = 48;
@@ -124,7 +126,7 @@ TEST(ViewSlfScene, FrameIsTheReferenceFromTheOrbitedCamera) {
   expected.near_plane = 0.5;
   expected.far_plane = 10;
   const render::Image cpu =
-      render::render_slf_reference(baked().model, expected, {true, kBackground});
+      render::render_slf_reference(baked().model, expected, {true, kBackground, true});
   EXPECT_GT(covered(cpu), 64 * 48 / 4);
   EXPECT_LE(differing(frame->image, cpu, kTolerance), kEdgePixels);
   EXPECT_EQ(frame->stats.passes, 1);
@@ -138,15 +140,16 @@ TEST(ViewSlfScene, FrameIsTheReferenceFromTheOrbitedCamera) {
   ASSERT_EQ(front->request_error, "");
   EXPECT_GT(differing(front->image, cpu, kTolerance), 64 * 48 / 8);
   expected.eye = Vector3d(0, 0, 3.2);
-  EXPECT_LE(differing(front->image,
-                      render::render_slf_reference(baked().model, expected, {true, kBackground}),
-                      kTolerance),
-            kEdgePixels);
+  EXPECT_LE(
+      differing(front->image,
+                render::render_slf_reference(baked().model, expected, {true, kBackground, true}),
+                kTolerance),
+      kEdgePixels);
 }
 
 // cam_pitch turns the eye about the camera's right axis (+X here) toward -Y, up with it.
 TEST(ViewSlfScene, PitchedAndSupersampledFrameIsTheFilteredLargeReference) {
-  viewer::SlfScene scene(inputs());
+  viewer::SlfScene scene(inputs(render::SlfShading::kOnePass));
   ViewState s;
   s.width = 40;
   s.height = 30;
@@ -189,7 +192,7 @@ TEST(ViewSlfScene, WhatTheBakedLightingCannotShowIsRefusedWithItsReason) {
       {[](ViewState& s) { s.register_budget = 256; }, "budget=256: "},
       {[](ViewState& s) { s.clusters_per_pass = 1; }, "cpp=1: "},
   };
-  viewer::SlfScene scene(inputs());
+  viewer::SlfScene scene(inputs(render::SlfShading::kAutomatic));
   for (const auto& [change, reason] : cases) {
     ViewState s;
     s.width = s.height = 16;

@@ -416,9 +416,9 @@ void run_slf(const Options& o, Clock::time_point start) {
       [&](int f) { return renderer.render(orbit_camera(big, centre, axis, frame_radians(o, f))); },
       [&](render::Image& samples) { renderer.read_image(samples); }};
   char line[200];
-  std::snprintf(line, sizeof line, "slf, %s, %d x %d texels, %d x %d directions",
-                renderer.deferred() ? "one shading pass after a uv pass" : "one pass",
-                model.map_width, model.map_height, model.grid.azimuth, model.grid.elevation);
+  std::snprintf(line, sizeof line, "slf, %s shading, %d x %d texels, %d x %d directions",
+                render::kSlfShadingNames.name(renderer.options().shading), model.map_width,
+                model.map_height, model.grid.azimuth, model.grid.elevation);
   render_outputs(o, camera, source, line, start);
 }
 

@@ -256,11 +256,11 @@ void run_slf(const Options& o, CLI::App* cmd) {
     std::printf("rendered    %s -> %s%s%s (%d x %d)\n", o.compressed.c_str(), o.output.c_str(),
                 o.png.empty() ? "" : ", ", o.png.c_str(), o.view.width, o.view.height);
     std::printf(
-        "slf         %s, %d cluster(s), %d PCA term(s), %d x %d texels, %d x %d "
+        "slf         %s shading, %d cluster(s), %d PCA term(s), %d x %d texels, %d x %d "
         "directions, baked under %s\n",
-        renderer.deferred() ? "one shading pass after a uv pass" : "one pass", model.clusters,
-        model.components, model.map_width, model.map_height, model.grid.azimuth,
-        model.grid.elevation, slf.probe_name.c_str());
+        render::kSlfShadingNames.name(renderer.shading()), model.clusters, model.components,
+        model.map_width, model.map_height, model.grid.azimuth, model.grid.elevation,
+        slf.probe_name.c_str());
     std::printf("timing      %.2f FPS: frame %.2f ms median over %d frames\n",
                 median > 0 ? 1000.0 / median : 0.0, median, o.frames);
     std::printf("image       %d x %d samples per pixel, %.2f ms for the written frame\n",

@@ -56,6 +56,7 @@
   X(glDisableVertexAttribArray)  \
   X(glDispatchCompute)           \
   X(glDrawArrays)                \
+  X(glDrawArraysInstanced)       \
   X(glDrawBuffers)               \
   X(glDrawElements)              \
   X(glEnable)                    \
@@ -79,6 +80,7 @@
   X(glGetIntegerv)               \
   X(glGetProgramInfoLog)         \
   X(glGetProgramiv)              \
+  X(glGetQueryObjectui64v)       \
   X(glGetQueryObjectuiv)         \
   X(glGetShaderInfoLog)          \
   X(glGetShaderiv)               \
@@ -103,6 +105,7 @@
   X(glUniformMatrix3fv)          \
   X(glUniformMatrix4fv)          \
   X(glUseProgram)                \
+  X(glVertexAttribDivisor)       \
   X(glVertexAttribIPointer)      \
   X(glVertexAttribPointer)       \
   X(glViewport)
@@ -169,6 +172,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glDisableVertexAttribArray (::render::gl::current->glDisableVertexAttribArray)
 #define glDispatchCompute (::render::gl::current->glDispatchCompute)
 #define glDrawArrays (::render::gl::current->glDrawArrays)
+#define glDrawArraysInstanced (::render::gl::current->glDrawArraysInstanced)
 #define glDrawBuffers (::render::gl::current->glDrawBuffers)
 #define glDrawElements (::render::gl::current->glDrawElements)
 #define glEnable (::render::gl::current->glEnable)
@@ -192,6 +196,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glGetIntegerv (::render::gl::current->glGetIntegerv)
 #define glGetProgramInfoLog (::render::gl::current->glGetProgramInfoLog)
 #define glGetProgramiv (::render::gl::current->glGetProgramiv)
+#define glGetQueryObjectui64v (::render::gl::current->glGetQueryObjectui64v)
 #define glGetQueryObjectuiv (::render::gl::current->glGetQueryObjectuiv)
 #define glGetShaderInfoLog (::render::gl::current->glGetShaderInfoLog)
 #define glGetShaderiv (::render::gl::current->glGetShaderiv)
@@ -216,6 +221,7 @@ std::vector<std::string> load(Functions& table, GetProc get_proc);
 #define glUniformMatrix3fv (::render::gl::current->glUniformMatrix3fv)
 #define glUniformMatrix4fv (::render::gl::current->glUniformMatrix4fv)
 #define glUseProgram (::render::gl::current->glUseProgram)
+#define glVertexAttribDivisor (::render::gl::current->glVertexAttribDivisor)
 #define glVertexAttribIPointer (::render::gl::current->glVertexAttribIPointer)
 #define glVertexAttribPointer (::render::gl::current->glVertexAttribPointer)
 #define glViewport (::render::gl::current->glViewport)

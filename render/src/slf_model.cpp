@@ -1,6 +1,8 @@
 #include "render/slf_model.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -80,8 +82,60 @@ void SlfModel::validate() const {
                                std::to_string(t / std::size_t(map_width)) + ") has cluster " +
                                std::to_string(texel_cluster[t]) + "; clusters run 0.." +
                                std::to_string(clusters - 1) + " (-1: unused)");
+  slf_model_checks::check_size(texel_positions.size(), texels, "texel_positions",
+                               "one per texel (map_width x map_height)");
+  for (std::size_t t = 0; t < texels; ++t)
+    if (!texel_positions[t].allFinite())
+      slf_model_checks::refuse("texel_positions[" + std::to_string(t) +
+                               "] is not finite; rebuild the model from finite data");
   slf_model_checks::check_finite(texel_weights, "texel_weights");
   slf_model_checks::check_finite(view_maps, "view_maps");
+}
+
+std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model) {
+  const std::size_t texels = std::size_t(model.map_width) * std::size_t(model.map_height);
+  std::vector<Eigen::Vector3f> points(texels, Eigen::Vector3f::Zero());
+  // Squared uv distance (in texels) from each texel centre to the triangle giving its point.
+  std::vector<float> best(texels, std::numeric_limits<float>::infinity());
+  const Eigen::Vector2f scale(float(model.map_width), float(model.map_height));
+  for (std::size_t t = 0; t + 2 < model.positions.size(); t += 3) {
+    const Eigen::Vector2f a = model.uv[t].cwiseProduct(scale),
+                          b = model.uv[t + 1].cwiseProduct(scale),
+                          c = model.uv[t + 2].cwiseProduct(scale);
+    const Eigen::Vector2f e1 = b - a, e2 = c - a;
+    const float det = e1.x() * e2.y() - e1.y() * e2.x();
+    if (det == 0.f) continue;  // no area in uv: no texel centre maps onto it
+    // Texels within two of the triangle's uv box: the ones a bilinear lookup inside can read.
+    const int x0 = std::max(0, int(std::floor(std::min({a.x(), b.x(), c.x()}))) - 2);
+    const int x1 =
+        std::min(model.map_width - 1, int(std::floor(std::max({a.x(), b.x(), c.x()}))) + 2);
+    const int y0 = std::max(0, int(std::floor(std::min({a.y(), b.y(), c.y()}))) - 2);
+    const int y1 =
+        std::min(model.map_height - 1, int(std::floor(std::max({a.y(), b.y(), c.y()}))) + 2);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        const std::size_t texel = std::size_t(y) * std::size_t(model.map_width) + std::size_t(x);
+        if (model.texel_cluster[texel] < 0) continue;
+        const Eigen::Vector2f q = Eigen::Vector2f(float(x) + 0.5f, float(y) + 0.5f) - a;
+        float u = (q.x() * e2.y() - q.y() * e2.x()) / det;
+        float v = (e1.x() * q.y() - e1.y() * q.x()) / det;
+        // Onto the triangle: clamp to the barycentric simplex (near enough the nearest point
+        // for the few texels outside every triangle).
+        u = std::max(u, 0.f);
+        v = std::max(v, 0.f);
+        if (u + v > 1.f) {
+          const float s = u + v;
+          u /= s;
+          v /= s;
+        }
+        const float distance = (a + u * e1 + v * e2 - (q + a)).squaredNorm();
+        if (!(distance < best[texel])) continue;
+        best[texel] = distance;
+        points[texel] = (1.f - u - v) * model.positions[t] + u * model.positions[t + 1] +
+                        v * model.positions[t + 2];
+      }
+  }
+  return points;
 }
 
 }  // namespace render

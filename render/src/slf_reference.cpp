@@ -49,9 +49,12 @@ Eigen::Vector3d view_lookup(const SlfModel& model, int cluster, int slice,
 
 }  // namespace slf_reference_taps
 
-Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
-                             const Eigen::Vector3d& direction) {
-  const SlfDirectionTaps taps = slf_direction_taps(model.grid, direction);
+namespace slf_reference_taps {
+
+// The spatial blend of Eq. 7 with bilinear weights; `taps_of(texel)` gives the direction
+// taps that texel is reconstructed at.
+template <typename TapsOf>
+Eigen::Vector3f blend(const SlfModel& model, const Eigen::Vector2f& uv, const TapsOf& taps_of) {
   const double sx = double(uv.x()) * model.map_width - 0.5;
   const double sy = double(uv.y()) * model.map_height - 0.5;
   const double x0 = std::floor(sx), y0 = std::floor(sy);
@@ -67,14 +70,29 @@ Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
       const std::size_t texel = std::size_t(y) * std::size_t(model.map_width) + std::size_t(x);
       const int cluster = model.texel_cluster[texel];
       if (cluster < 0) continue;
-      Eigen::Vector3d texel_radiance = slf_reference_taps::view_lookup(model, cluster, 0, taps);
+      const SlfDirectionTaps taps = taps_of(texel);
+      Eigen::Vector3d texel_radiance = view_lookup(model, cluster, 0, taps);
       const float* u = model.texel_weights.data() + texel * std::size_t(k);
       for (int j = 0; j < k; ++j)
-        texel_radiance +=
-            double(u[j]) * slf_reference_taps::view_lookup(model, cluster, 1 + j, taps);
+        texel_radiance += double(u[j]) * view_lookup(model, cluster, 1 + j, taps);
       sum += weight * texel_radiance;
     }
   return sum.cwiseMax(0.0).cast<float>();  // after the blend: render/slf_reference.h
+}
+
+}  // namespace slf_reference_taps
+
+Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
+                             const Eigen::Vector3d& direction) {
+  const SlfDirectionTaps taps = slf_direction_taps(model.grid, direction);
+  return slf_reference_taps::blend(model, uv, [&](std::size_t) { return taps; });
+}
+
+Eigen::Vector3f slf_radiance_toward(const SlfModel& model, const Eigen::Vector2f& uv,
+                                    const Eigen::Vector3d& eye) {
+  return slf_reference_taps::blend(model, uv, [&](std::size_t texel) {
+    return slf_direction_taps(model.grid, eye - model.texel_positions[texel].cast<double>());
+  });
 }
 
 Image render_slf_reference(const SlfModel& model, const Camera& camera,
@@ -177,7 +195,9 @@ Image render_slf_reference(const SlfModel& model, const Camera& camera,
               continue;
             }
             const Eigen::Vector3f c =
-                slf_radiance(model, hit_uv[at], -camera.pixel_direction(x, y));
+                options.texel_directions
+                    ? slf_radiance_toward(model, hit_uv[at], eye)
+                    : slf_radiance(model, hit_uv[at], -camera.pixel_direction(x, y));
             out[0] = c.x();
             out[1] = c.y();
             out[2] = c.z();

@@ -19,7 +19,11 @@ namespace render {
 namespace slf_gl {
 
 // Texture units, fixed in the shader's layout(binding) qualifiers.
-constexpr int kClusterUnit = 0, kViewsUnit = 1, kWeightsUnit = 2, kUvUnit = 3;
+constexpr int kClusterUnit = 0, kViewsUnit = 1, kWeightsUnit = 2, kUvUnit = 3, kPositionsUnit = 4,
+              kRadianceUnit = 5;
+// Texture-space shading works in square blocks of texels of this side (a multiple of
+// llvmpipe's 4 x 4 shading quads).
+constexpr int kBlock = 8;
 
 // How the clusters' view maps tile one layer of the view-map array.
 struct TileLayout {
@@ -108,6 +112,66 @@ std::string fullscreen_vertex_shader() {
          "}\n";
 }
 
+// Declarations every reconstructing shader shares: the textures and the sizes, all literal.
+std::string reconstruction_declarations(const SlfModel& model, const TileLayout& tiles) {
+  const int k = model.components;
+  std::string s;
+  s += "layout(binding = " + std::to_string(kClusterUnit) + ") uniform isampler2D u_cluster;\n";
+  s += "layout(binding = " + std::to_string(kViewsUnit) + ") uniform sampler2DArray u_views;\n";
+  if (k > 0)
+    s += "layout(binding = " + std::to_string(kWeightsUnit) +
+         ") uniform sampler2DArray u_weights;\n";
+  s += "const vec2 kMap = vec2(" + float_literal(model.map_width) + ", " +
+       float_literal(model.map_height) + ");\n";
+  s += "const ivec2 kMapMax = ivec2(" + std::to_string(model.map_width - 1) + ", " +
+       std::to_string(model.map_height - 1) + ");\n";
+  s += "const vec2 kTile = vec2(" + float_literal(tiles.tile_width) + ", " +
+       float_literal(tiles.tile_height) + ");\n";
+  s += "const vec2 kAtlasScale = vec2(" + float_literal(1.0 / tiles.width()) + ", " +
+       float_literal(1.0 / tiles.height()) + ");\n";
+  s += "const int kTileColumns = " + std::to_string(tiles.columns) + ";\n";
+  // Where (xi1, xi2) falls in a tile, in texels: column i's centre at 1 + i + 0.5.
+  s += "const vec2 kGridScale = vec2(" + float_literal(0.5 * model.grid.azimuth) + ", " +
+       float_literal(model.grid.elevation) + ");\n";
+  s += "const float kInvPi = " + float_literal(1.0 / 3.14159265358979323846) + ";\n";
+  return s;
+}
+
+// From the direction `d` (toward the viewer) to `p`, its place in a view-map tile.
+std::string direction_to_tile(const std::string& indent) {
+  // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
+  return indent + "float azimuth = (d.x == 0.0 && d.z == 0.0) ? 0.0 : atan(d.x, -d.z);\n" + indent +
+         "vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(d.y, -1.0, 1.0)) * kInvPi);\n" +
+         indent + "vec2 p = vec2(1.0) + xi * kGridScale;\n";
+}
+
+// Adds to `l` cluster `t`'s reconstruction at `p` with the mean's coefficient `a0` and the
+// components' in `u0`, `u1`, ... (four a vec4). The k + 1 slices' RGB values are packed four
+// floats a texel (view_layers).
+std::string view_sum(int k, const std::string& indent) {
+  std::string s = indent +
+                  "vec2 q = (vec2(t % kTileColumns, t / kTileColumns) * kTile + p) * "
+                  "kAtlasScale;\n";
+  const int view_layers = slf_gl::view_layers(k);
+  for (int v = 0; v < view_layers; ++v)
+    s += indent + "vec4 t" + std::to_string(v) + " = textureLod(u_views, vec3(q, " +
+         float_literal(v) + "), 0.0);\n";
+  for (int f = 0; f < 3 * (k + 1); ++f) {
+    const int slice = f / 3, channel = f % 3;
+    std::string coefficient = "a0";
+    if (slice > 0) {
+      coefficient = "u";  // appended: GCC 12's -Wstringop-overflow misfires on "u" + string
+      coefficient += std::to_string((slice - 1) / 4);
+      coefficient += '.';
+      coefficient += "xyzw"[(slice - 1) % 4];
+    }
+    s += indent + "l.";
+    s += "xyz"[channel];
+    s += " += " + coefficient + " * t" + std::to_string(f / 4) + "." + "xyzw"[f % 4] + ";\n";
+  }
+  return s;
+}
+
 // Every size is a literal, and the sums over components are written out, so the compiler
 // sees constant layer indices (llvmpipe runs such code markedly faster than loops over
 // uniforms, render/shader_source.h). textureLod throughout: the fetches sit in a loop with
@@ -136,24 +200,7 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   } else {
     s += "in vec3 v_world;\nin vec2 v_uv;\nuniform vec3 u_eye;\n";
   }
-  s += "layout(binding = " + std::to_string(kClusterUnit) + ") uniform isampler2D u_cluster;\n";
-  s += "layout(binding = " + std::to_string(kViewsUnit) + ") uniform sampler2DArray u_views;\n";
-  if (k > 0)
-    s += "layout(binding = " + std::to_string(kWeightsUnit) +
-         ") uniform sampler2DArray u_weights;\n";
-  s += "const vec2 kMap = vec2(" + float_literal(model.map_width) + ", " +
-       float_literal(model.map_height) + ");\n";
-  s += "const ivec2 kMapMax = ivec2(" + std::to_string(model.map_width - 1) + ", " +
-       std::to_string(model.map_height - 1) + ");\n";
-  s += "const vec2 kTile = vec2(" + float_literal(tiles.tile_width) + ", " +
-       float_literal(tiles.tile_height) + ");\n";
-  s += "const vec2 kAtlasScale = vec2(" + float_literal(1.0 / tiles.width()) + ", " +
-       float_literal(1.0 / tiles.height()) + ");\n";
-  s += "const int kTileColumns = " + std::to_string(tiles.columns) + ";\n";
-  // Where (xi1, xi2) falls in a tile, in texels: column i's centre at 1 + i + 0.5.
-  s += "const vec2 kGridScale = vec2(" + float_literal(0.5 * model.grid.azimuth) + ", " +
-       float_literal(model.grid.elevation) + ");\n";
-  s += "const float kInvPi = " + float_literal(1.0 / 3.14159265358979323846) + ";\n";
+  s += reconstruction_declarations(model, tiles);
   s += "void main() {\n";
   if (deferred)
     s += "  vec2 v_uv = texelFetch(u_uv, ivec2(gl_FragCoord.xy), 0).xy;\n"
@@ -161,22 +208,18 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
          "  vec3 d = -normalize(u_forward + ndc.x * u_right + ndc.y * u_up);\n";
   else
     s += "  vec3 d = normalize(u_eye - v_world);\n";
-  s +=
-      // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
-      "  float azimuth = (d.x == 0.0 && d.z == 0.0) ? 0.0 : atan(d.x, -d.z);\n"
-      "  vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(d.y, -1.0, 1.0)) * kInvPi);\n"
-      "  vec2 p = vec2(1.0) + xi * kGridScale;\n"
-      "  vec2 st = v_uv * kMap - 0.5;\n"
-      "  vec2 b = floor(st);\n"
-      "  vec2 f = st - b;\n"
-      "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
-      "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
-      // Texels (lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y) as x, y, z, w.
-      "  ivec4 c = textureGather(u_cluster, (b + 1.0) / kMap).wzxy;\n"
-      "  vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * "
-      "f.y);\n"
-      // Texels left to sum: used (cluster >= 0) and of non-zero weight.
-      "  vec4 left = vec4(greaterThanEqual(c, ivec4(0))) * vec4(greaterThan(w, vec4(0.0)));\n";
+  s += direction_to_tile("  ");
+  s += "  vec2 st = v_uv * kMap - 0.5;\n"
+       "  vec2 b = floor(st);\n"
+       "  vec2 f = st - b;\n"
+       "  ivec2 lo = clamp(ivec2(b), ivec2(0), kMapMax);\n"
+       "  ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), kMapMax);\n"
+       // Texels (lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y) as x, y, z, w.
+       "  ivec4 c = textureGather(u_cluster, (b + 1.0) / kMap).wzxy;\n"
+       "  vec4 w = vec4((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * "
+       "f.y);\n"
+       // Texels left to sum: used (cluster >= 0) and of non-zero weight.
+       "  vec4 left = vec4(greaterThanEqual(c, ivec4(0))) * vec4(greaterThan(w, vec4(0.0)));\n";
   const char* corner[4] = {"lo", "ivec2(hi.x, lo.y)", "ivec2(lo.x, hi.y)", "hi"};
   for (int i = 0; i < 4; ++i)
     for (int l = 0; l < layers; ++l)
@@ -194,32 +237,14 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   s += "    left -= take;\n"
        "    vec4 m = take * w;\n"
        "    int t = max(cl, 0);\n"
-       "    vec2 q = (vec2(t % kTileColumns, t / kTileColumns) * kTile + p) * kAtlasScale;\n"
        "    float a0 = m.x + m.y + m.z + m.w;\n";
   for (int l = 0; l < layers; ++l) {
     const std::string n = std::to_string(l);
     s += "    vec4 u" + n + " = m.x * u0_" + n + " + m.y * u1_" + n + " + m.z * u2_" + n +
          " + m.w * u3_" + n + ";\n";
   }
-  // The k + 1 slices' RGB values, packed four floats a texel (view_layers); slice 0's
-  // coefficient is the weights' sum, slice 1 + j's the interpolated weight j.
-  const int view_layers = slf_gl::view_layers(k);
-  for (int v = 0; v < view_layers; ++v)
-    s += "    vec4 t" + std::to_string(v) + " = textureLod(u_views, vec3(q, " + float_literal(v) +
-         "), 0.0);\n";
-  for (int f = 0; f < 3 * (k + 1); ++f) {
-    const int slice = f / 3, channel = f % 3;
-    std::string coefficient = "a0";
-    if (slice > 0) {
-      coefficient = "u";  // appended: GCC 12's -Wstringop-overflow misfires on "u" + string
-      coefficient += std::to_string((slice - 1) / 4);
-      coefficient += '.';
-      coefficient += "xyzw"[(slice - 1) % 4];
-    }
-    s += "    l.";
-    s += "xyz"[channel];
-    s += " += " + coefficient + " * t" + std::to_string(f / 4) + "." + "xyzw"[f % 4] + ";\n";
-  }
+  // Slice 0's coefficient is the weights' sum, slice 1 + j's the interpolated weight j.
+  s += view_sum(k, "    ");
   // Negative radiance clamped after the spatial blend, as render/slf_reference.h explains.
   s += "  } while (any(greaterThan(left, vec4(0.0))));\n"
        "  o_colour = vec4(max(l, vec3(0.0)), 1.0);\n"
@@ -227,9 +252,176 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   return s;
 }
 
-// Unset, the context decides: deferred on a software rasterizer (render/slf_renderer.h).
-bool resolve_deferred(const SlfRendererOptions& options) {
-  return options.deferred.value_or(current_gl_info().software_rasterizer());
+// Texture space, first pass: one quad per 8 x 8 block in view (an instance each, the
+// block's corner texel as the attribute) over the radiance map.
+std::string block_vertex_shader(const SlfModel& model) {
+  return "#version 450 core\n"
+         "layout(location = 0) in ivec2 a_block;\n"
+         "void main() {\n"
+         "  vec2 corner = vec2(gl_VertexID & 1, gl_VertexID >> 1);\n"
+         "  vec2 texel = vec2(a_block) + corner * " +
+         float_literal(kBlock) +
+         ";\n"
+         "  gl_Position = vec4(texel / vec2(" +
+         float_literal(model.map_width) + ", " + float_literal(model.map_height) +
+         ") * 2.0 - 1.0, 0.0, 1.0);\n"
+         "}\n";
+}
+
+// Texture space: the texel's own reconstruction toward the eye from its surface point,
+// unclamped (the clamp follows the spatial blend, in the mesh's pass). Unused texels are 0,
+// as the blend leaves them out. A loop of at most one iteration rather than an if, so that a
+// 4 x 4 group of unused texels skips the work (see fragment_shader).
+std::string texel_fragment_shader(const SlfModel& model, const TileLayout& tiles) {
+  const int k = model.components, layers = (k + 3) / 4;
+  std::string s = "#version 450 core\n";
+  s += "layout(location = 0) out vec4 o_colour;\nuniform vec3 u_eye;\n";
+  s += "layout(binding = " + std::to_string(kPositionsUnit) + ") uniform sampler2D u_positions;\n";
+  s += reconstruction_declarations(model, tiles);
+  s += "void main() {\n"
+       "  ivec2 texel = ivec2(gl_FragCoord.xy);\n"
+       "  int t = texelFetch(u_cluster, texel, 0).r;\n"
+       "  vec3 l = vec3(0.0);\n"
+       "  for (int once = t >= 0 ? 1 : 0; once > 0; --once) {\n"
+       "    vec3 d = normalize(u_eye - texelFetch(u_positions, texel, 0).xyz);\n";
+  s += direction_to_tile("    ");
+  s += "    float a0 = 1.0;\n";
+  for (int l = 0; l < layers; ++l)
+    s += "    vec4 u" + std::to_string(l) + " = texelFetch(u_weights, ivec3(texel, " +
+         std::to_string(l) + "), 0);\n";
+  s += view_sum(k, "    ");
+  s += "  }\n"
+       "  o_colour = vec4(l, 1.0);\n"
+       "}\n";
+  return s;
+}
+
+// Texture space, the mesh's pass: the radiance map's bilinear fetch at the atlas coordinate
+// (texel centres at (x + 0.5) / X, clamped at the border: slf_reference's blend).
+std::string radiance_fragment_shader() {
+  return "#version 450 core\n"
+         "in vec3 v_world;\nin vec2 v_uv;\n"
+         "layout(location = 0) out vec4 o_colour;\n"
+         "layout(binding = " +
+         std::to_string(kRadianceUnit) +
+         ") uniform sampler2D u_radiance;\n"
+         "void main() {\n"
+         "  o_colour = vec4(max(textureLod(u_radiance, v_uv, 0.0).rgb, vec3(0.0)), 1.0);\n"
+         "}\n";
+}
+
+// The screen path the context suits: deferred on a software rasterizer (render/slf_renderer.h).
+SlfShading screen_shading(const SlfRendererOptions& options) {
+  if (options.shading == SlfShading::kOnePass || options.shading == SlfShading::kDeferred)
+    return options.shading;
+  return current_gl_info().software_rasterizer() ? SlfShading::kDeferred : SlfShading::kOnePass;
+}
+
+// What SlfRenderer::shading() says before the first frame.
+SlfShading first_shading(const SlfRendererOptions& options) {
+  if (options.shading == SlfShading::kAutomatic) return SlfShading::kTextureSpace;
+  return options.shading == SlfShading::kTextureSpace ? options.shading : screen_shading(options);
+}
+
+// An 8 x 8 block of the surface map that some triangle's lookups read, with what decides
+// whether any of those triangles can be seen: a cone around `axis` holding their face
+// normals (cos and sin of its half-angle; cos -1 where they face every way) and a sphere
+// holding their corners.
+struct TexelBlock {
+  std::int32_t x = 0, y = 0;  // its first texel
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero(), centre = Eigen::Vector3d::Zero();
+  double cone_cos = -1, cone_sin = 0, radius = 0;
+};
+
+// The blocks holding the texels each triangle's bilinear lookups can read (its uv box, one
+// texel wider on the high side, in texel indices as the lookup floors them).
+std::vector<TexelBlock> texel_blocks(const SlfModel& model) {
+  const int columns = (model.map_width + kBlock - 1) / kBlock;
+  const int rows = (model.map_height + kBlock - 1) / kBlock;
+  const std::size_t count = std::size_t(columns) * std::size_t(rows);
+  std::vector<Eigen::Vector3d> normal_sum(count, Eigen::Vector3d::Zero());
+  std::vector<Eigen::AlignedBox3d> box(count);
+  std::vector<std::vector<std::uint32_t>> readers(count);
+  const std::size_t triangles = model.positions.size() / 3;
+  std::vector<Eigen::Vector3d> normals(triangles);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const Eigen::Vector3d p0 = model.positions[3 * t].cast<double>();
+    const Eigen::Vector3d p1 = model.positions[3 * t + 1].cast<double>();
+    const Eigen::Vector3d p2 = model.positions[3 * t + 2].cast<double>();
+    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
+    normals[t] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+    double lo_x = 1e30, lo_y = 1e30, hi_x = -1e30, hi_y = -1e30;
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector2f uv = model.uv[3 * t + std::size_t(i)];
+      lo_x = std::min(lo_x, double(uv.x()) * model.map_width - 0.5);
+      hi_x = std::max(hi_x, double(uv.x()) * model.map_width - 0.5);
+      lo_y = std::min(lo_y, double(uv.y()) * model.map_height - 0.5);
+      hi_y = std::max(hi_y, double(uv.y()) * model.map_height - 0.5);
+    }
+    const int x0 = std::clamp(int(std::floor(lo_x)), 0, model.map_width - 1) / kBlock;
+    const int x1 = std::clamp(int(std::floor(hi_x)) + 1, 0, model.map_width - 1) / kBlock;
+    const int y0 = std::clamp(int(std::floor(lo_y)), 0, model.map_height - 1) / kBlock;
+    const int y1 = std::clamp(int(std::floor(hi_y)) + 1, 0, model.map_height - 1) / kBlock;
+    for (int by = y0; by <= y1; ++by)
+      for (int bx = x0; bx <= x1; ++bx) {
+        const std::size_t b = std::size_t(by) * std::size_t(columns) + std::size_t(bx);
+        readers[b].push_back(std::uint32_t(t));
+        normal_sum[b] += normals[t];
+        box[b].extend(p0).extend(p1).extend(p2);
+      }
+  }
+  std::vector<TexelBlock> blocks;
+  for (std::size_t b = 0; b < count; ++b) {
+    if (readers[b].empty()) continue;
+    TexelBlock block;
+    block.x = std::int32_t(b % std::size_t(columns)) * kBlock;
+    block.y = std::int32_t(b / std::size_t(columns)) * kBlock;
+    block.centre = box[b].center();
+    block.radius = 0.5 * box[b].diagonal().norm();
+    const double length = normal_sum[b].norm();
+    bool cone = length > 1e-9;
+    double lowest = 1;
+    if (cone) {
+      block.axis = normal_sum[b] / length;
+      for (std::uint32_t t : readers[b]) {
+        if (normals[t].isZero()) cone = false;  // no orientation: never culled
+        lowest = std::min(lowest, normals[t].dot(block.axis));
+      }
+    }
+    if (cone) {
+      block.cone_cos = std::clamp(lowest, -1.0, 1.0);
+      block.cone_sin = std::sqrt(std::max(0.0, 1.0 - block.cone_cos * block.cone_cos));
+    }
+    blocks.push_back(block);
+  }
+  return blocks;
+}
+
+// Whether a block's triangles may all face away from `eye` (the eye behind every one of
+// their planes): n . (eye - p) <= n . (eye - centre) + radius, whose largest value over the
+// cone is |v| cos(max(0, phi - theta)) + radius, phi the angle between the axis and v.
+bool faces_away(const TexelBlock& block, const Eigen::Vector3d& eye) {
+  if (block.cone_cos <= -1) return false;
+  const Eigen::Vector3d v = eye - block.centre;
+  const double distance = v.norm();
+  if (distance <= block.radius) return false;
+  const double cos_phi = block.axis.dot(v) / distance;
+  if (cos_phi >= block.cone_cos) return false;  // phi <= theta: a normal may point at the eye
+  const double sin_phi = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
+  const double cos_gap = cos_phi * block.cone_cos + sin_phi * block.cone_sin;  // cos(phi - theta)
+  return distance * cos_gap + block.radius < 0.0;
+}
+
+// Whether a block's sphere lies wholly outside one of the view frustum's planes.
+bool outside_frustum(const TexelBlock& block, const Eigen::Matrix4d& clip_from_world) {
+  for (int axis = 0; axis < 3; ++axis)
+    for (double sign : {-1.0, 1.0}) {
+      const Eigen::Vector4d plane = clip_from_world.row(3) + sign * clip_from_world.row(axis);
+      const double length = plane.head<3>().norm();
+      if (length == 0.0) continue;
+      if ((plane.head<3>().dot(block.centre) + plane.w()) / length < -block.radius) return true;
+    }
+  return false;
 }
 
 void texture_parameters(GLenum target, GLint filter) {
@@ -246,20 +438,36 @@ void texture_parameters(GLenum target, GLint filter) {
 struct SlfRenderer::Impl {
   Impl(const SlfModel& model, const probes::Probe* probe, const SlfRendererOptions& options);
   ~Impl();
-  void build_program();
+  void build_programs();
   void draw(const Camera& camera);
   void draw_deferred(const Camera& camera);
+  void draw_mesh(GlProgram& with, const Camera& camera);
+  // Texture space: the blocks in view, in `visible_blocks` (x, y pairs).
+  void find_visible_blocks(const Camera& camera);
+  void shade_texels(const Camera& camera);
+  SlfShading choose(const Camera& camera);
   void bind_textures();
 
   SlfRendererOptions options;
-  bool deferred = false;  // options.deferred, resolved against the context
-  SlfModel shape;         // sizes only (the arrays are uploaded and dropped)
+  SlfShading screen = SlfShading::kOnePass;  // the screen path (options and context)
+  SlfShading last = SlfShading::kOnePass;    // the last frame's path
+  SlfModel shape;                            // sizes only (the arrays are uploaded and dropped)
   slf_gl::TileLayout tiles;
   GLuint vao = 0, vbo = 0, cluster_texture = 0, views_texture = 0, weights_texture = 0;
   GLuint uv_texture = 0;  // deferred: the pre-pass's atlas coordinates, at the frame's size
   int uv_width = 0, uv_height = 0;
   GLsizei vertex_count = 0;
-  GlProgram program, uv_program;
+  // Texture space: texel points, the radiance map and its framebuffer, the block instances.
+  GLuint positions_texture = 0, radiance_texture = 0, radiance_fbo = 0;
+  GLuint block_vao = 0, block_vbo = 0;
+  std::vector<slf_gl::TexelBlock> blocks;
+  std::vector<std::int32_t> visible_blocks;
+  // Fragments the last frame's mesh shaded (a sample query), for the automatic choice;
+  // negative before the first frame.
+  GLuint samples_query = 0;
+  long long last_samples = -1;
+  int counted_width = 0, counted_height = 0;  // the frame size last_samples was counted at
+  GlProgram program, uv_program, texel_program, radiance_program;
   BackgroundPass background_pass;
   Background background;
   FrameTarget target;
@@ -268,7 +476,8 @@ struct SlfRenderer::Impl {
 SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
                         const SlfRendererOptions& renderer_options)
     : options(renderer_options),
-      deferred(slf_gl::resolve_deferred(renderer_options)),
+      screen(slf_gl::screen_shading(renderer_options)),
+      last(slf_gl::first_shading(renderer_options)),
       background_pass(probe) {
   model.validate();
   shape.map_width = model.map_width;
@@ -372,22 +581,71 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
   slf_gl::texture_parameters(GL_TEXTURE_2D_ARRAY, GL_LINEAR);
   check_gl("SlfRenderer: textures");
 
-  build_program();
+  // Texture space: each texel's surface point, and the radiance map it shades into (zero
+  // until a frame writes it; texels never written are read with weight 0 or not at all).
+  std::vector<float> points(texels * 4, 0.f);
+  for (std::size_t t = 0; t < texels; ++t)
+    for (int i = 0; i < 3; ++i) points[t * 4 + std::size_t(i)] = model.texel_positions[t][i];
+  glGenTextures(1, &positions_texture);
+  glBindTexture(GL_TEXTURE_2D, positions_texture);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, x_size, y_size, 0, GL_RGBA, GL_FLOAT, points.data());
+  slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
+  std::fill(points.begin(), points.end(), 0.f);
+  glGenTextures(1, &radiance_texture);
+  glBindTexture(GL_TEXTURE_2D, radiance_texture);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, x_size, y_size, 0, GL_RGBA, GL_FLOAT, points.data());
+  slf_gl::texture_parameters(GL_TEXTURE_2D, GL_LINEAR);
+  glGenFramebuffers(1, &radiance_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, radiance_fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, radiance_texture, 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw GlError("surface light field: this context cannot render into a " +
+                  std::to_string(x_size) + " x " + std::to_string(y_size) +
+                  " RGBA32F radiance map; use --shading one-pass or deferred");
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  blocks = slf_gl::texel_blocks(model);
+  glGenVertexArrays(1, &block_vao);
+  glBindVertexArray(block_vao);
+  glGenBuffers(1, &block_vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, block_vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(blocks.size() * 2 * sizeof(std::int32_t)), nullptr,
+               GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribIPointer(0, 2, GL_INT, 2 * sizeof(std::int32_t), nullptr);
+  glVertexAttribDivisor(0, 1);
+  glBindVertexArray(0);
+  glGenQueries(1, &samples_query);
+  check_gl("SlfRenderer: texture-space set-up");
+
+  build_programs();
   background.use_probe = background_pass.has_probe();
   check_gl("SlfRenderer: set-up");
 }
 
-void SlfRenderer::Impl::build_program() {
-  if (deferred) {
-    program =
-        GlProgram("surface light field (deferred shading)", slf_gl::fullscreen_vertex_shader(),
-                  slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path, true));
-    uv_program = GlProgram("surface light field (uv pre-pass)", slf_gl::vertex_shader(),
-                           slf_gl::uv_fragment_shader());
-  } else {
-    program =
-        GlProgram("surface light field", slf_gl::vertex_shader(),
-                  slf_gl::fragment_shader(shape, tiles, options.shared_cluster_fast_path, false));
+// The screen path's programs, and texture space's unless a screen path is asked for.
+void SlfRenderer::Impl::build_programs() {
+  const bool fast = options.shared_cluster_fast_path;
+  program = GlProgram();
+  uv_program = GlProgram();
+  if (options.shading != SlfShading::kTextureSpace) {
+    if (screen == SlfShading::kDeferred) {
+      program =
+          GlProgram("surface light field (deferred shading)", slf_gl::fullscreen_vertex_shader(),
+                    slf_gl::fragment_shader(shape, tiles, fast, true));
+      uv_program = GlProgram("surface light field (uv pre-pass)", slf_gl::vertex_shader(),
+                             slf_gl::uv_fragment_shader());
+    } else {
+      program = GlProgram("surface light field", slf_gl::vertex_shader(),
+                          slf_gl::fragment_shader(shape, tiles, fast, false));
+    }
+  }
+  const bool texture_space =
+      options.shading == SlfShading::kAutomatic || options.shading == SlfShading::kTextureSpace;
+  if (texture_space && texel_program.id() == 0) {
+    texel_program = GlProgram("surface light field (texels)", slf_gl::block_vertex_shader(shape),
+                              slf_gl::texel_fragment_shader(shape, tiles));
+    radiance_program = GlProgram("surface light field (radiance map)", slf_gl::vertex_shader(),
+                                 slf_gl::radiance_fragment_shader());
   }
 }
 
@@ -398,6 +656,12 @@ SlfRenderer::Impl::~Impl() {
   glDeleteTextures(1, &views_texture);
   if (weights_texture) glDeleteTextures(1, &weights_texture);
   if (uv_texture) glDeleteTextures(1, &uv_texture);
+  glDeleteTextures(1, &positions_texture);
+  glDeleteTextures(1, &radiance_texture);
+  glDeleteFramebuffers(1, &radiance_fbo);
+  glDeleteBuffers(1, &block_vbo);
+  glDeleteVertexArrays(1, &block_vao);
+  glDeleteQueries(1, &samples_query);
 }
 
 void SlfRenderer::Impl::bind_textures() {
@@ -429,11 +693,7 @@ void SlfRenderer::Impl::draw_deferred(const Camera& camera) {
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, uv_texture, 0);
   const GLenum uv_only[2] = {GL_NONE, GL_COLOR_ATTACHMENT1};
   glDrawBuffers(2, uv_only);
-  uv_program.use();
-  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
-  glUniformMatrix4fv(uv_program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
-  glBindVertexArray(vao);
-  glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+  draw_mesh(uv_program, camera);
   glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
   const GLenum colour_only[1] = {GL_COLOR_ATTACHMENT0};
   glDrawBuffers(1, colour_only);
@@ -458,13 +718,82 @@ void SlfRenderer::Impl::draw_deferred(const Camera& camera) {
   glActiveTexture(GL_TEXTURE0 + slf_gl::kUvUnit);
   glBindTexture(GL_TEXTURE_2D, uv_texture);
   glActiveTexture(GL_TEXTURE0);
+  glBindVertexArray(vao);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glBindVertexArray(0);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
 }
 
+// The mesh with `with`, counting its fragments when the automatic choice needs them.
+void SlfRenderer::Impl::draw_mesh(GlProgram& with, const Camera& camera) {
+  with.use();
+  const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
+  glUniformMatrix4fv(with.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
+  const Eigen::Vector3f eye = camera.eye.cast<float>();
+  glUniform3f(with.uniform("u_eye"), eye.x(), eye.y(), eye.z());
+  glBindVertexArray(vao);
+  const bool count = options.shading == SlfShading::kAutomatic;
+  if (count) glBeginQuery(GL_SAMPLES_PASSED, samples_query);
+  glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+  if (count) glEndQuery(GL_SAMPLES_PASSED);
+  glBindVertexArray(0);
+}
+
+void SlfRenderer::Impl::find_visible_blocks(const Camera& camera) {
+  visible_blocks.clear();
+  const Eigen::Matrix4d clip = camera.clip_from_world();
+  for (const slf_gl::TexelBlock& block : blocks) {
+    if (options.cull_back_faces && slf_gl::faces_away(block, camera.eye)) continue;
+    if (slf_gl::outside_frustum(block, clip)) continue;
+    visible_blocks.push_back(block.x);
+    visible_blocks.push_back(block.y);
+  }
+}
+
+// Texture space's first pass: the blocks in view into the radiance map.
+void SlfRenderer::Impl::shade_texels(const Camera& camera) {
+  glBindFramebuffer(GL_FRAMEBUFFER, radiance_fbo);
+  glViewport(0, 0, shape.map_width, shape.map_height);
+  glDisable(GL_DEPTH_TEST);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_BLEND);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  const GLsizei instances = GLsizei(visible_blocks.size() / 2);
+  if (instances == 0) return;
+  texel_program.use();
+  const Eigen::Vector3f eye = camera.eye.cast<float>();
+  glUniform3f(texel_program.uniform("u_eye"), eye.x(), eye.y(), eye.z());
+  bind_textures();
+  glActiveTexture(GL_TEXTURE0 + slf_gl::kPositionsUnit);
+  glBindTexture(GL_TEXTURE_2D, positions_texture);
+  glActiveTexture(GL_TEXTURE0);
+  glBindVertexArray(block_vao);
+  glBindBuffer(GL_ARRAY_BUFFER, block_vbo);
+  glBufferSubData(GL_ARRAY_BUFFER, 0, GLsizeiptr(visible_blocks.size() * sizeof(std::int32_t)),
+                  visible_blocks.data());
+  glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, instances);
+  glBindVertexArray(0);
+}
+
+// Texture space when the texels to shade are no more than the fragments the screen would
+// shade: the last frame's count, or before the first frame every pixel of this one.
+SlfShading SlfRenderer::Impl::choose(const Camera& camera) {
+  if (options.shading != SlfShading::kAutomatic && options.shading != SlfShading::kTextureSpace)
+    return screen;
+  find_visible_blocks(camera);
+  if (options.shading == SlfShading::kTextureSpace) return SlfShading::kTextureSpace;
+  const long long texels = (long long)(visible_blocks.size() / 2) * slf_gl::kBlock * slf_gl::kBlock;
+  // A frame of another size says little about this one's fragments.
+  if (camera.width != counted_width || camera.height != counted_height) last_samples = -1;
+  const long long fragments =
+      last_samples >= 0 ? last_samples : (long long)camera.width * camera.height;
+  return texels <= fragments ? SlfShading::kTextureSpace : screen;
+}
+
 void SlfRenderer::Impl::draw(const Camera& camera) {
+  last = choose(camera);
+  if (last == SlfShading::kTextureSpace) shade_texels(camera);
   target.bind(camera.width, camera.height);
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   glDepthMask(GL_TRUE);
@@ -488,18 +817,16 @@ void SlfRenderer::Impl::draw(const Camera& camera) {
   } else {
     glDisable(GL_CULL_FACE);
   }
-  if (deferred) {
+  if (last == SlfShading::kDeferred) {
     draw_deferred(camera);
+  } else if (last == SlfShading::kTextureSpace) {
+    glActiveTexture(GL_TEXTURE0 + slf_gl::kRadianceUnit);
+    glBindTexture(GL_TEXTURE_2D, radiance_texture);
+    glActiveTexture(GL_TEXTURE0);
+    draw_mesh(radiance_program, camera);
   } else {
-    program.use();
-    const Eigen::Matrix4f clip = camera.clip_from_world().cast<float>();
-    glUniformMatrix4fv(program.uniform("u_clip_from_world"), 1, GL_FALSE, clip.data());
-    const Eigen::Vector3f eye = camera.eye.cast<float>();
-    glUniform3f(program.uniform("u_eye"), eye.x(), eye.y(), eye.z());
     bind_textures();
-    glBindVertexArray(vao);
-    glDrawArrays(GL_TRIANGLES, 0, vertex_count);
-    glBindVertexArray(0);
+    draw_mesh(program, camera);
   }
   glDisable(GL_CULL_FACE);
 }
@@ -519,17 +846,31 @@ void SlfRenderer::set_probe(const probes::Probe* probe) {
 }
 
 void SlfRenderer::set_options(const SlfRendererOptions& options) {
-  const bool deferred = slf_gl::resolve_deferred(options);
   const bool rebuild =
       options.shared_cluster_fast_path != impl_->options.shared_cluster_fast_path ||
-      deferred != impl_->deferred;
+      options.shading != impl_->options.shading;
   impl_->options = options;
-  impl_->deferred = deferred;
-  if (rebuild) impl_->build_program();
+  impl_->screen = slf_gl::screen_shading(options);
+  impl_->last = slf_gl::first_shading(options);
+  impl_->last_samples = -1;
+  if (rebuild) impl_->build_programs();
 }
 
-bool SlfRenderer::deferred() const {
-  return impl_->deferred;
+const SlfRendererOptions& SlfRenderer::options() const {
+  return impl_->options;
+}
+
+long long SlfRenderer::texels_shaded() const {
+  if (impl_->last != SlfShading::kTextureSpace) return 0;
+  return (long long)(impl_->visible_blocks.size() / 2) * slf_gl::kBlock * slf_gl::kBlock;
+}
+
+long long SlfRenderer::texels_in_blocks() const {
+  return (long long)impl_->blocks.size() * slf_gl::kBlock * slf_gl::kBlock;
+}
+
+SlfShading SlfRenderer::shading() const {
+  return impl_->last;
 }
 
 FrameTiming SlfRenderer::render(const Camera& camera) {
@@ -538,6 +879,13 @@ FrameTiming SlfRenderer::render(const Camera& camera) {
   const auto start = Clock::now();
   impl_->draw(camera);
   glFinish();
+  if (impl_->options.shading == SlfShading::kAutomatic) {
+    GLuint64 samples = 0;
+    glGetQueryObjectui64v(impl_->samples_query, GL_QUERY_RESULT, &samples);
+    impl_->last_samples = (long long)samples;
+    impl_->counted_width = camera.width;
+    impl_->counted_height = camera.height;
+  }
   FrameTiming timing;
   timing.gl_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   timing.total_ms = timing.gl_ms;

@@ -93,6 +93,7 @@ SlfScene::SlfScene(SlfSceneInputs inputs) : impl_(std::make_unique<Impl>(std::mo
   m.info = context_scene_info(m.context.info());
   render::SlfRendererOptions ro;
   ro.cull_back_faces = m.inputs.cull_back_faces;
+  ro.shading = m.inputs.shading;
   m.renderer = std::make_unique<render::SlfRenderer>(*m.inputs.model, m.inputs.probe, ro);
   m.renderer->set_background(m.inputs.background);
   m.clusters = m.inputs.model->clusters;

@@ -33,6 +33,10 @@ struct SlfModel {
 
   std::vector<std::int32_t> texel_cluster;  // X Y, row-major (y * X + x); -1: no triangle reads it
   std::vector<float> texel_weights;         // X Y k: the surface map U
+  // X Y: the surface point each texel samples (meshes::Atlas::texel_barycentric on its
+  // triangle); any finite value where the cluster is -1. Texture-space shading takes a
+  // texel's view direction from it, as the paper does per texel.
+  std::vector<Eigen::Vector3f> texel_positions;
   // clusters (k + 1) Z W 3: cluster, slice (0 the mean, 1 + j component j), direction
   // column j Z + i, then RGB. The view maps V.
   std::vector<float> view_maps;
@@ -44,5 +48,11 @@ struct SlfModel {
   // Throws std::invalid_argument naming the first inconsistent size.
   void validate() const;
 };
+
+// For models made by hand (tests, benchmarks) rather than from an atlas: each used texel's
+// point is where its centre falls on the triangle whose uv contains it, else on the triangle
+// nearest in uv, barycentrics clamped onto it (the atlas's gutter rule, charts aside).
+// Needs the geometry, uv, map size and texel_cluster; other texels get (0, 0, 0).
+std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model);
 
 }  // namespace render

@@ -15,8 +15,9 @@
 //    a texture unit cannot do. Bilinear weights interpolate, are continuous across cells and
 //    the seam, and are what the GPU's filtering of a view-map tile with a one-texel gutter
 //    gives in one fetch, so the GL path and this reference compute the same function.
-//  - Every texel uses the fragment's own direction; the paper recomputes it from each of the
-//    four texels' surface points, which differ by less than a texel and are not in the model.
+//  - Every texel uses the fragment's own direction (slf_radiance), or, as the paper does, its
+//    own: from the texel's surface point toward the eye (slf_radiance_toward, what
+//    texture-space shading computes). The two differ by the angle a texel subtends at the eye.
 //  - Negative radiance is clamped to 0 per channel once, after the spatial blend: CPCA's
 //    reconstruction of a noisy matrix undershoots where the data is near zero (a silhouette
 //    whose red and green go below zero shows as blue dots). Clamping each texel before the
@@ -52,9 +53,15 @@ SlfDirectionTaps slf_direction_taps(const prt::SlfGrid& grid, const Eigen::Vecto
 Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
                              const Eigen::Vector3d& direction);
 
+// The same with each texel reconstructed toward `eye` from its own surface point
+// (SlfModel::texel_positions).
+Eigen::Vector3f slf_radiance_toward(const SlfModel& model, const Eigen::Vector2f& uv,
+                                    const Eigen::Vector3d& eye);
+
 struct SlfReferenceOptions {
   bool cull_back_faces = true;                           // as the GL path's option
   Eigen::Vector3f background = Eigen::Vector3f::Zero();  // misses (alpha 0)
+  bool texel_directions = false;  // slf_radiance_toward: texture-space shading's image
 };
 
 // The image the GL path draws, by ray casting: each pixel centre's ray (Camera::

@@ -22,18 +22,33 @@
 // sum by linearity. A loop, not an if: llvmpipe runs both sides of a branch for its whole
 // SIMD group, but leaves a loop once no lane needs another iteration.
 //
-// Deferred option: the mesh is first drawn with a trivial shader writing its atlas
-// coordinates (and depth), then one screen-sized triangle, depth-tested against it, shades
-// the covered pixels, the direction from the pixel's ray. The same reconstruction, but
-// llvmpipe shades in 4 x 4 blocks, so a mesh of 5-pixel triangles (the bunny at 1280 x 948)
-// costs the one-pass shader several blocks a triangle; shading once per covered pixel halves
-// the frame there (bench/slf_bench.cpp).
+// Three ways to shade (SlfShading), one image up to where each texel's direction is taken:
+//  - one pass: the fragment shader of the mesh's own pass reconstructs;
+//  - deferred: the mesh is first drawn with a trivial shader writing its atlas coordinates
+//    (and depth), then one screen-sized triangle, depth-tested against it, shades the covered
+//    pixels, the direction from the pixel's ray. llvmpipe shades in 4 x 4 blocks, so a mesh
+//    of 5-pixel triangles (the bunny at 1280 x 948) costs the one-pass shader several blocks
+//    a triangle;
+//  - texture space: the reconstruction runs once per texel into a radiance map of the
+//    surface map's size, each texel toward the eye from its own surface point (the paper's
+//    per-texel direction, slf_radiance_toward), then the mesh's pass reads that map with one
+//    bilinear fetch (the same spatial blend by linearity; negatives clamped after it). Only
+//    the 8 x 8 blocks of texels that some triangle in view and facing the eye can read are
+//    shaded: per block, a cone bounding the normals of the triangles that read it and a
+//    sphere bounding those triangles, tested on the CPU every frame. The cost follows the
+//    texels in view instead of the pixels covered: at a 256 x 256 map (prtr slf's default)
+//    an order of magnitude fewer reconstructions than a 1280 x 948 frame of the bunny.
+// The automatic choice (the default) shades in texture space when the texels to shade are no
+// more than the fragments the last frame's mesh shaded (a sample query; before the first
+// frame, the frame's pixels), and otherwise on the screen: deferred on a software rasterizer,
+// one pass on a GPU.
 //
 // Precision: on Mesa's rasterisers the filter weights are single floats; a hardware GPU's
 // texture units may quantise them (8 fractional bits on many), which rounds the
 // interpolation between neighbouring directions by up to 1/512 of their difference.
 #pragma once
 
+#include "common/enum_names.h"
 #include "probes/probe.h"
 #include "render/camera.h"
 #include "render/image.h"
@@ -41,20 +56,23 @@
 #include "render/slf_model.h"
 
 #include <memory>
-#include <optional>
 
 namespace render {
+
+enum class SlfShading { kAutomatic, kOnePass, kDeferred, kTextureSpace };
+inline constexpr auto kSlfShadingNames = common::enum_table<SlfShading>(
+    "surface light field shading", {{SlfShading::kAutomatic, "auto"},
+                                    {SlfShading::kOnePass, "one-pass"},
+                                    {SlfShading::kDeferred, "deferred"},
+                                    {SlfShading::kTextureSpace, "texture-space"}});
 
 struct SlfRendererOptions {
   bool cull_back_faces = true;  // closed meshes; the SLF of a face seen from behind is not stored
   // Sum the texels cluster by cluster (see above); false reconstructs each of the four
   // texels on its own, to measure the difference.
   bool shared_cluster_fast_path = true;
-  // Shade after a uv pre-pass instead of in the mesh's own pass (see above). Unset: the
-  // context decides, deferred on a software rasterizer (llvmpipe shades whole 4 x 4 blocks,
-  // so small triangles cost the one-pass shader several times their pixels), one pass on a
-  // GPU. The image is the same either way.
-  std::optional<bool> deferred{};
+  // Where the reconstruction runs (see above); automatic: chosen per frame by its cost.
+  SlfShading shading = SlfShading::kAutomatic;
 };
 
 class SlfRenderer {
@@ -71,10 +89,16 @@ class SlfRenderer {
 
   // The probe (when there is one and use_probe is set) or the solid colour behind the mesh.
   void set_background(const Background& background);
-  // Whether frames are shaded after a uv pre-pass: the option, or the context's choice.
-  bool deferred() const;
+  // How the last frame was shaded, never kAutomatic (before the first frame: texture space
+  // for the automatic choice, else the option as this context resolves it).
+  SlfShading shading() const;
+  // Texels the last frame shaded in texture space (its blocks in view, 64 each; 0 on a
+  // screen path), and the texels of every block some triangle reads.
+  long long texels_shaded() const;
+  long long texels_in_blocks() const;
   void set_probe(const probes::Probe* probe);
   void set_options(const SlfRendererOptions& options);
+  const SlfRendererOptions& options() const;
 
   // Draws one frame (background, then the mesh in one pass; waits with glFinish).
   FrameTiming render(const Camera& camera);

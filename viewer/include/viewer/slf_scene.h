@@ -13,6 +13,7 @@
 #include "render/gl_context.h"
 #include "render/renderer.h"
 #include "render/slf_model.h"
+#include "render/slf_renderer.h"
 #include "viewer/frame_source.h"
 #include "viewer/scene.h"
 
@@ -30,6 +31,7 @@ struct SlfSceneInputs {
   render::Background background;
   render::GlSelection gl;
   bool cull_back_faces = true;
+  render::SlfShading shading = render::SlfShading::kAutomatic;
 };
 
 class SlfScene : public FrameSource {
