@@ -180,7 +180,8 @@ TEST(EpsilonSearch, MeetsTheErrorConstraint) {
   const cpca::DataMatrix x = smooth_data(g, 5);
   cpca::CompressOptions lbg = options(cpca::ClusterMethod::kLbg, 0);
   cpca::CompressReport original;
-  cpca::compress(x, lbg, nullptr, &original);
+  const std::vector<std::uint32_t> reference_clusters =
+      cpca::compress(x, lbg, nullptr, &original).cluster_of;
   const double reference = original.error.average_squared_error;
   ASSERT_GT(reference, 0);
   cpca::CompressOptions first = options(cpca::ClusterMethod::kPatchFirst, 0);
@@ -200,8 +201,11 @@ TEST(EpsilonSearch, MeetsTheErrorConstraint) {
     if (start.error.average_squared_error <= (1 + eps) * reference) {
       EXPECT_LE(search.triangles_drawn, start_draws);
     }
-    // The given reference is the same constraint as the one computed inside.
+    // The given reference (error and clusters) is the same constraint and the same patch
+    // weights as the one computed inside; an error without its clusters is refused.
     o.error_target = reference;
+    EXPECT_THROW(cpca::compress_joint(x, o, g), std::invalid_argument);
+    o.reference_clusters = reference_clusters;
     const cpca::CompressedSet again = cpca::compress_joint(x, o, g);
     EXPECT_EQ(again.cluster_of, set.cluster_of);
   }
@@ -209,6 +213,7 @@ TEST(EpsilonSearch, MeetsTheErrorConstraint) {
   // the start on this data): the search has to lower the error below its start.
   cpca::CompressOptions o = options(cpca::ClusterMethod::kPatchEpsilon, 0);
   o.error_target = 0.93 * start.error.average_squared_error;
+  o.reference_clusters = reference_clusters;
   cpca::JointSearchResult search;
   cpca::CompressReport report;
   const cpca::CompressedSet set = cpca::compress_joint(x, o, g, &report, &search);

@@ -128,4 +128,70 @@ TEST(PatchFirst, NeedsTheMesh) {
   EXPECT_THROW(cpca::compress(x, o), std::invalid_argument);
 }
 
+// Each cluster of the clustering weighs the same in all: a vertex of a cluster of n weighs
+// 1 / n of a unit, so small clusters' vertices weigh more.
+TEST(PatchFirst, ClusterDensityWeightsGiveEveryClusterTheSameWeight) {
+  const std::vector<std::uint32_t> cluster_of = {0, 0, 0, 0, 1, 2, 2, 1, 0, 2};
+  const std::vector<std::uint32_t> w = cpca::cluster_density_weights(cluster_of, 3);
+  ASSERT_EQ(w.size(), cluster_of.size());
+  std::vector<double> total(3, 0);
+  for (std::size_t v = 0; v < w.size(); ++v) total[cluster_of[v]] += w[v];
+  for (double t : total) EXPECT_NEAR(t, total[0], 2.0);  // integer rounding, one per vertex
+  EXPECT_GT(w[4], w[0]);                 // cluster 1 has 2 vertices, cluster 0 has 5
+  EXPECT_GT(double(total[0]) * 3, 9e8);  // the sum uses most of METIS's 32 bits, and fits
+  EXPECT_LT(double(total[0]) * 3, 2.1e9);
+  EXPECT_THROW(cpca::cluster_density_weights(cluster_of, 2), std::invalid_argument);
+}
+
+// Patches balance the vertices' weight, not their count: with the left half of a grid
+// weighing 3 times the right, every patch holds about the same weight, so those on the left
+// hold fewer vertices; unweighted, every patch holds about the same number of vertices.
+TEST(PatchFirst, PatchesBalanceVertexWeights) {
+  const int n = 32;
+  const cpca::Geometry g = cpca_test::grid(n);
+  cpca::DataMatrix x(Eigen::Index(n * n), 3);
+  for (int p = 0; p < n * n; ++p)
+    x.row(p) = g.positions[std::size_t(p)].transpose();  // similarity weights near uniform
+  std::vector<std::uint32_t> weight(std::size_t(n * n));
+  for (int p = 0; p < n * n; ++p)
+    weight[std::size_t(p)] = g.positions[std::size_t(p)].x() < 0.5f ? 3 : 1;
+  const std::vector<int> counts(8, 3);
+  struct Spread {
+    double weight, size;  // largest over smallest patch
+  };
+  auto spread = [&](const std::vector<std::uint32_t>& of) {
+    std::vector<double> w(8, 0), size(8, 0);
+    for (int p = 0; p < n * n; ++p) {
+      w[of[std::size_t(p)]] += weight[std::size_t(p)];
+      size[of[std::size_t(p)]] += 1;
+    }
+    return Spread{
+        *std::max_element(w.begin(), w.end()) / *std::min_element(w.begin(), w.end()),
+        *std::max_element(size.begin(), size.end()) / *std::min_element(size.begin(), size.end())};
+  };
+  const Spread weighted = spread(cpca::partition_patches(x, g, counts, 1, weight));
+  EXPECT_LT(weighted.weight, 1.1);
+  EXPECT_GT(weighted.size, 2.0);  // 3 ideally: a left patch has a third of a right one's
+  const Spread plain = spread(cpca::partition_patches(x, g, counts, 1));
+  EXPECT_LT(plain.size, 1.1);
+  EXPECT_GT(plain.weight, 2.0);
+  EXPECT_THROW(cpca::partition_patches(x, g, counts, 1, std::vector<std::uint32_t>(5, 1)),
+               std::invalid_argument);
+}
+
+// Equal compact passes of a 20 x 20 grid: one pass draws every triangle once; two equal halves
+// cost at least a straight cut (19 cells, 38 triangles drawn twice, 1 + 38 / 722), and METIS
+// finds one within a few cells of it; more passes cost more.
+TEST(PatchFirst, EqualPatchesOverdrawIsNearTheShortestCut) {
+  const cpca::Geometry g = cpca_test::grid(20);
+  EXPECT_EQ(cpca::equal_patches_overdraw(g, 1, 1), 1.0);
+  const double straight = 1.0 + 38.0 / 722.0;
+  const double two = cpca::equal_patches_overdraw(g, 2, 1);
+  EXPECT_GE(two, straight - 1e-12);
+  EXPECT_LT(two, 1.0 + 1.3 * 38.0 / 722.0);
+  EXPECT_GT(cpca::equal_patches_overdraw(g, 8, 1), two);
+  EXPECT_THROW(cpca::equal_patches_overdraw(g, 0, 1), std::invalid_argument);
+  EXPECT_THROW(cpca::equal_patches_overdraw(g, 401, 1), std::invalid_argument);
+}
+
 }  // namespace

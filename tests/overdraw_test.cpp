@@ -294,7 +294,8 @@ TEST(OverdrawReport, TablesCsvAndJsonCarryEveryRow) {
 }
 
 // Under each table: the lowest-overdraw row whose Average SE and image RMSE are within 1.05 x
-// the original's (a lower-overdraw row with 1.2 x the SE is passed over), with its bound's gap.
+// the original's (a lower-overdraw row with 1.2 x the SE is passed over), with its bound's gap
+// and what equal compact passes draw.
 TEST(OverdrawReport, BestRowWithinTheErrorAndItsGap) {
   overdraw::OverdrawReport r;
   const auto add = [&](const char* method, double od, double bound, double se, double rmse) {
@@ -307,6 +308,7 @@ TEST(OverdrawReport, BestRowWithinTheErrorAndItsGap) {
     row.overdraw_bound = bound;
     row.average_se = se;
     row.image_rmse = rmse;
+    row.equal_patches_overdraw = 1.07;
     r.rows.push_back(row);
   };
   add("original", 1.4, 1.3, 1.0, 1.0);
@@ -316,11 +318,13 @@ TEST(OverdrawReport, BestRowWithinTheErrorAndItsGap) {
   EXPECT_NE(md.find("| original | ils | 0.0 s | 1.400000 | 1.3000 |"), std::string::npos) << md;
   EXPECT_NE(md.find("Best row with Average SE and image RMSE <= 1.05 x original's: patch-eps / "
                     "ils, overdraw 1.1250 (SE 1.000 x, RMSE 1.040 x); its bound 1.1000, gap "
-                    "0.0250; lowest bound of the table 1.0800."),
+                    "0.0250; lowest bound of the table 1.0800; equal compact passes of the mesh "
+                    "alone (METIS, error ignored) draw 1.0700."),
             std::string::npos)
       << md;
   const nlohmann::json js = nlohmann::json::parse(overdraw::json(r));
   EXPECT_EQ(js.at("rows").at(2).at("overdraw_bound").get<double>(), 1.1);
+  EXPECT_EQ(js.at("rows").at(2).at("equal_patches_overdraw").get<double>(), 1.07);
 }
 
 // Every string field carries a file name or a GL string the user does not control: quotes,

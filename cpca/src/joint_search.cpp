@@ -632,6 +632,7 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   auto t = Clock::now();
   double target = 0;
   double reference_seconds = 0;
+  CompressOptions start_options = options;
   if (options.method == ClusterMethod::kPatchEpsilon) {
     if (!(options.error_slack >= 0) || !std::isfinite(options.error_slack))
       throw std::invalid_argument(
@@ -642,10 +643,17 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
     if (!(reference > 0)) {
       CompressOptions original = options;
       original.method = ClusterMethod::kLbg;
+      original.reference_clusters.clear();
       CompressReport original_report;
-      compress(data, original, nullptr, &original_report);
+      start_options.reference_clusters =
+          compress(data, original, nullptr, &original_report).cluster_of;
       reference = original_report.error.average_squared_error;
       reference_seconds = seconds(t);
+    } else if (options.reference_clusters.size() != std::size_t(data.rows())) {
+      throw std::invalid_argument(
+          "patch-eps: a given reference (error target) needs its clusters, one per vertex; got " +
+          std::to_string(options.reference_clusters.size()) + " for " +
+          std::to_string(data.rows()) + " vertices");
     }
     target = (1 + options.error_slack) * reference;
     // An exact reference (zero error) leaves no room: any positive cap below float rounding.
@@ -653,7 +661,7 @@ CompressedSet compress_joint(const Eigen::Ref<const DataMatrix>& data,
   }
   std::vector<double> error;
   std::vector<std::uint32_t> pass_of;
-  CompressedSet set = joint_start(data, options, geometry, rep, error, pass_of);
+  CompressedSet set = joint_start(data, start_options, geometry, rep, error, pass_of);
   rep.lbg_seconds += reference_seconds;
   const double start_seconds = seconds(t);
   t = Clock::now();

@@ -14,6 +14,7 @@ std::vector<std::uint32_t> metis_kway(const KwayGraph& graph, const KwayOptions&
   std::vector<idx_t> adjwgt(graph.weight.begin(), graph.weight.end());
   adjncy.push_back(0);
   adjwgt.push_back(0);
+  std::vector<idx_t> vwgt(graph.node_weight.begin(), graph.node_weight.end());
   std::vector<real_t> shares(options.shares.begin(), options.shares.end());
   std::vector<idx_t> part(std::size_t(nodes), 0);
   idx_t metis_options[METIS_NOPTIONS];
@@ -21,9 +22,10 @@ std::vector<std::uint32_t> metis_kway(const KwayGraph& graph, const KwayOptions&
   metis_options[METIS_OPTION_NUMBERING] = 0;
   metis_options[METIS_OPTION_SEED] = idx_t(options.seed & 0x7fffffff);
   if (options.imbalance > 0) metis_options[METIS_OPTION_UFACTOR] = options.imbalance;
-  const int rc = METIS_PartGraphKway(
-      &nodes, &constraints, xadj.data(), adjncy.data(), nullptr, nullptr, adjwgt.data(), &parts,
-      shares.empty() ? nullptr : shares.data(), nullptr, metis_options, &cut, part.data());
+  const int rc = METIS_PartGraphKway(&nodes, &constraints, xadj.data(), adjncy.data(),
+                                     vwgt.empty() ? nullptr : vwgt.data(), nullptr, adjwgt.data(),
+                                     &parts, shares.empty() ? nullptr : shares.data(), nullptr,
+                                     metis_options, &cut, part.data());
   if (rc != METIS_OK)
     throw std::runtime_error("METIS_PartGraphKway failed (code " + std::to_string(rc) + ") on " +
                              std::to_string(nodes) + " " + options.nodes + " into " +

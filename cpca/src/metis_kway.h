@@ -12,13 +12,14 @@ namespace cpca {
 struct KwayGraph {
   std::vector<std::uint32_t> offset;  // node n's neighbours: [offset[n], offset[n + 1])
   std::vector<std::uint32_t> neighbor;
-  std::vector<std::uint32_t> weight;  // one per neighbor entry
+  std::vector<std::uint32_t> weight;       // one per neighbor entry
+  std::vector<std::uint32_t> node_weight;  // one per node, what parts balance; empty: 1 each
 };
 
 struct KwayOptions {
   int parts = 1;
   std::uint64_t seed = 1;
-  // Each part's share of the nodes (sums to 1); empty: equal parts.
+  // Each part's share of the nodes' weight (sums to 1); empty: equal parts.
   std::vector<float> shares;
   // Allowed imbalance in 1/1000 above the share; 0 keeps METIS's default (3%).
   int imbalance = 0;

@@ -51,8 +51,10 @@ std::vector<std::uint32_t> similarity_weights(const Eigen::Ref<const DataMatrix>
 
 std::vector<std::uint32_t> metis_patches(std::size_t vertices, const std::vector<Edge>& edges,
                                          const std::vector<std::uint32_t>& weight,
-                                         const std::vector<int>& counts, std::uint64_t seed) {
+                                         const std::vector<int>& counts, std::uint64_t seed,
+                                         const std::vector<std::uint32_t>& vertex_weight) {
   KwayGraph g;
+  g.node_weight = vertex_weight;
   g.offset.assign(vertices + 1, 0);
   for (const Edge& e : edges) ++g.offset[e.first + 1], ++g.offset[e.second + 1];
   for (std::size_t v = 0; v < vertices; ++v) g.offset[v + 1] += g.offset[v];
@@ -152,10 +154,32 @@ std::vector<int> patch_cluster_counts(int cluster_count, int per_pass) {
   return counts;
 }
 
+std::vector<std::uint32_t> cluster_density_weights(const std::vector<std::uint32_t>& cluster_of,
+                                                   int cluster_count) {
+  std::vector<std::uint64_t> size(std::size_t(std::max(cluster_count, 1)), 0);
+  for (std::uint32_t c : cluster_of) {
+    if (c >= size.size())
+      throw std::invalid_argument("cluster density weights: a vertex names cluster " +
+                                  std::to_string(c) + " of " + std::to_string(cluster_count));
+    ++size[c];
+  }
+  // A cluster's vertices weigh `unit` together, and all of them together about 1e9 < 2^31.
+  const double unit = 1e9 / double(size.size());
+  std::vector<std::uint32_t> weight;
+  weight.reserve(cluster_of.size());
+  for (std::uint32_t c : cluster_of)
+    weight.push_back(std::uint32_t(std::max(1.0, std::round(unit / double(size[c])))));
+  return weight;
+}
+
 std::vector<std::uint32_t> partition_patches(const Eigen::Ref<const DataMatrix>& data,
                                              const Geometry& geometry,
-                                             const std::vector<int>& counts, std::uint64_t seed) {
+                                             const std::vector<int>& counts, std::uint64_t seed,
+                                             const std::vector<std::uint32_t>& vertex_weight) {
   const std::size_t vertices = std::size_t(data.rows());
+  if (!vertex_weight.empty() && vertex_weight.size() != vertices)
+    throw std::invalid_argument("patch-first: " + std::to_string(vertex_weight.size()) +
+                                " vertex weights for " + std::to_string(vertices) + " vertices");
   std::int64_t total = 0;
   for (int c : counts) total += c;
   if (total > std::int64_t(vertices) || geometry.positions.size() != vertices)
@@ -165,9 +189,28 @@ std::vector<std::uint32_t> partition_patches(const Eigen::Ref<const DataMatrix>&
   if (counts.size() == 1) return std::vector<std::uint32_t>(vertices, 0);
   const std::vector<Edge> edges = mesh_edges(geometry);
   std::vector<std::uint32_t> patch_of =
-      metis_patches(vertices, edges, similarity_weights(data, edges), counts, seed);
+      metis_patches(vertices, edges, similarity_weights(data, edges), counts, seed, vertex_weight);
   repair_short_patches(patch_of, edges, counts);
   return patch_of;
+}
+
+double equal_patches_overdraw(const Geometry& geometry, int passes, std::uint64_t seed) {
+  const std::size_t vertices = geometry.positions.size();
+  if (passes < 1 || std::size_t(passes) > vertices)
+    throw std::invalid_argument("equal patches: " + std::to_string(passes) + " passes for " +
+                                std::to_string(vertices) + " vertices");
+  const std::size_t triangles = std::max<std::size_t>(geometry.triangles.size(), 1);
+  if (passes == 1) return 1.0;
+  const std::vector<Edge> edges = mesh_edges(geometry);
+  const std::vector<std::uint32_t> patch_of =
+      metis_patches(vertices, edges, std::vector<std::uint32_t>(edges.size(), 1),
+                    std::vector<int>(std::size_t(passes), 1), seed, {});
+  std::uint64_t drawn = 0;
+  for (const TriangleIndices& t : geometry.triangles) {
+    const std::uint32_t a = patch_of[t[0]], b = patch_of[t[1]], c = patch_of[t[2]];
+    drawn += 1 + (b != a) + (c != a && c != b);
+  }
+  return double(drawn) / double(triangles);
 }
 
 CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,
@@ -175,8 +218,14 @@ CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,
                                    CompressReport* report) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<int> counts = patch_cluster_counts(options.clusters, options.clusters_per_pass);
+  // patch-eps balances its patches by original CPCA's allocation of clusters over the surface
+  // (cluster_density_weights), so the passes follow the signal's complexity.
+  const std::vector<std::uint32_t> weight =
+      options.method == ClusterMethod::kPatchEpsilon && !options.reference_clusters.empty()
+          ? cluster_density_weights(options.reference_clusters, options.clusters)
+          : std::vector<std::uint32_t>{};
   const std::vector<std::uint32_t> patch_of =
-      partition_patches(data, geometry, counts, options.seed);
+      partition_patches(data, geometry, counts, options.seed, weight);
   // Each patch is compressed alone, so the whole set is built from ordinary compressions.
   CompressOptions inner = options;
   // patch-eps refines the whole set afterwards with its own refits, so its patches stop at

@@ -23,7 +23,7 @@ std::vector<std::uint32_t> metis_parts(const ClusterIncidence& inc, int parts, i
   o.imbalance = 1;  // 0.1%: as close to a hard capacity as it gets
   o.nodes = "clusters";
   o.advice = "try another strategy";
-  return metis_kway({inc.neighbor_offset, inc.neighbor, inc.neighbor_weight}, o);
+  return metis_kway({inc.neighbor_offset, inc.neighbor, inc.neighbor_weight, {}}, o);
 }
 
 // Moves clusters out of parts above capacity, each time the (cluster, part with room) pair

@@ -4,6 +4,7 @@
 
 #include "cpca/compressed_file.h"
 #include "cpca/overdraw_bound.h"
+#include "cpca/patch_first.h"
 #include "cpca/supercluster.h"
 #include "cpca/supercluster_strategy.h"
 #include "meshes/load.h"
@@ -23,6 +24,7 @@
 #include <ctime>
 #include <deque>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -108,6 +110,14 @@ struct Scene {
   std::vector<Eigen::Matrix3d> image_rotations;  // where image errors are measured
   std::vector<render::Image> references;         // the uncompressed render at each
   int context_budget = 0;
+  // cpca::equal_patches_overdraw per number of passes, computed once (rows run one by one).
+  mutable std::map<int, double> equal_patches;
+  double equal_patches_overdraw(int passes) const {
+    const auto [at, added] = equal_patches.try_emplace(passes, 1.0);
+    if (added && passes <= int(geometry.positions.size()))
+      at->second = cpca::equal_patches_overdraw(geometry, passes, plan.compress.seed);
+    return at->second;
+  }
 };
 
 void note(const OverdrawPlan& plan, const std::string& text) {
@@ -244,12 +254,14 @@ Compression compress_row(const Scene& s, const std::string& transfer_path, int k
     co.overdraw_cap = method.overdraw_cap;
   }
   if (method.designed == cpca::ClusterMethod::kPatchEpsilon) {
-    // The constraint's reference is the original row's Average SE at this K (the cached
-    // compression when that row ran): the row reports only its own clustering time.
+    // The constraint's reference is the original row at this K (the cached compression when
+    // that row ran): its Average SE and its clusters, which weigh the patches. The row
+    // reports only its own clustering time.
     bool original_cached = false;
-    co.error_target =
-        compress_row(s, transfer_path, k, find_method("original"), 0, &original_cached)
-            .summary.average_se;
+    Compression original =
+        compress_row(s, transfer_path, k, find_method("original"), 0, &original_cached);
+    co.error_target = original.summary.average_se;
+    co.reference_clusters = std::move(original.set.cluster_of);
   }
   // Compressions run without a progress bar (the run has its own), but cache repairs are told.
   pipeline::Reporter warnings_only;
@@ -361,6 +373,7 @@ OverdrawRow measure_row(const Scene& s, const Compression& c, const std::string&
   row.grouping_seconds = grouping_seconds;
   row.average_overdraw = od.average_overdraw;
   row.overdraw_bound = bound.average_overdraw;
+  row.equal_patches_overdraw = s.equal_patches_overdraw((c.k + per_pass - 1) / per_pass);
   row.triangles_drawn = od.triangles_drawn;
   row.average_se = c.summary.average_se;
   row.relative_error = c.summary.relative_error;

@@ -118,6 +118,13 @@ std::uint64_t hash_text(const std::string& text) {
   return common::fnv1a(text.data(), text.size());
 }
 
+// The reference clustering patch-eps weighs its patches by ("none" when it computes its own,
+// which then depends only on the rest of the key).
+std::string reference_hash(const std::vector<std::uint32_t>& clusters) {
+  if (clusters.empty()) return "none";
+  return hex(common::fnv1a(clusters.data(), clusters.size() * sizeof(std::uint32_t)));
+}
+
 void prepare(const fs::path& dir) {
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -256,7 +263,7 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
     key << " per-pass " << o.clusters_per_pass << " lambda " << o.lambda;
   if (o.method == cpca::ClusterMethod::kPatchEpsilon)
     key << " per-pass " << o.clusters_per_pass << " eps " << o.error_slack << " target "
-        << o.error_target;
+        << o.error_target << " density " << reference_hash(o.reference_clusters);
   if (o.overdraw_cap > 0) key << " cap " << o.overdraw_cap;
   const std::string stem = "cpca-" + hex(hash_text(key.str()));
   CompressCacheResult r;

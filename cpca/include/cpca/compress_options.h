@@ -49,10 +49,13 @@ struct CompressOptions {
   double overdraw_cap = 0.0;
   // patch-eps (joint_search.h): the least overdraw with Average SE <= (1 + error_slack) x a
   // reference, the Average SE of original CPCA (LBG + PCA, same K and seed). error_target > 0
-  // gives that reference's Average SE (a caller that has already compressed the original);
-  // 0 makes the method compress the original itself, inside its clustering time.
+  // gives that reference's Average SE and reference_clusters its cluster of every vertex (a
+  // caller that has already compressed the original; both or neither); 0 makes the method
+  // compress the original itself, inside its clustering time. The clusters weigh the patches
+  // (cpca::cluster_density_weights).
   double error_slack = 0.0;
   double error_target = 0.0;
+  std::vector<std::uint32_t> reference_clusters{};
 };
 
 // Triangles whose three vertices lie in 1, 2 or 3 distinct clusters.

@@ -23,13 +23,30 @@ namespace cpca {
 std::vector<int> patch_cluster_counts(int cluster_count, int per_pass);
 
 // The patch (0..counts.size()-1) of every vertex: METIS on the mesh's vertex graph, each
-// patch's share of vertices proportional to its cluster count, then repaired so that every
-// patch holds at least as many vertices as clusters. Edge weight 1 + round(100 exp(-d/d̄)),
-// d = ||x_i - x_j||^2 and d̄ its mean over the edges. Throws std::invalid_argument when
-// the mesh has fewer vertices than clusters.
+// patch's share of the vertices' weight (`vertex_weight`, one per vertex; empty: 1 each)
+// proportional to its cluster count, then repaired so that every patch holds at least as
+// many vertices as clusters. Edge weight 1 + round(100 exp(-d/d̄)), d = ||x_i - x_j||^2 and
+// d̄ its mean over the edges. Throws std::invalid_argument when the mesh has fewer
+// vertices than clusters or the weights are not one per vertex.
 std::vector<std::uint32_t> partition_patches(const Eigen::Ref<const DataMatrix>& data,
                                              const Geometry& geometry,
-                                             const std::vector<int>& counts, std::uint64_t seed);
+                                             const std::vector<int>& counts, std::uint64_t seed,
+                                             const std::vector<std::uint32_t>& vertex_weight = {});
+
+// Vertex weights that measure how much of a clustering's budget a vertex takes: 1 / |c| for a
+// vertex of cluster c (scaled to integers whose sum fits METIS's 32 bits), so each cluster
+// weighs the same. Patches balanced by them hold equal shares of the clusters that clustering
+// spent on their area: where the signal is complex (many small clusters) they are small,
+// where it is smooth they are large. patch-eps weighs by original CPCA's clusters.
+std::vector<std::uint32_t> cluster_density_weights(const std::vector<std::uint32_t>& cluster_of,
+                                                   int cluster_count);
+
+// A reference for what pass layouts can reach, not a bound: the average overdraw of the
+// mesh cut into `passes` equal patches by METIS on its plain vertex graph (unit edge
+// weights: the shortest borders it finds, the signal and the error ignored), each patch one
+// pass. Equal compact passes draw about this much however their clusters are chosen; a
+// pass-designing method goes below it only with unequal passes.
+double equal_patches_overdraw(const Geometry& geometry, int passes, std::uint64_t seed);
 
 // The whole method (CompressOptions::method == kPatchFirst; compress() dispatches here).
 // Inside each patch: options' components, solver, alpha (on the patch's own triangles) and

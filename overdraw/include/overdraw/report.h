@@ -28,6 +28,10 @@ struct OverdrawRow {
   // cpca::grouping_overdraw_bound: no grouping of this row's clustering into passes of
   // clusters_per_pass can draw less (a bound on the strategy's gap, not on other clusterings).
   double overdraw_bound = 1;
+  // cpca::equal_patches_overdraw for this row's least number of passes (ceil(K / per pass)):
+  // what equal compact passes of the mesh alone draw, the error ignored. A reference, not a
+  // bound.
+  double equal_patches_overdraw = 1;
   std::uint64_t triangles_drawn = 0;  // = the renderer's GL count (checked)
   // Medians over every timed frame of every interleaved round, with their quartiles (FPS per
   // frame is 1000 / frame ms, so its quartiles are the frame time's, inverted).
