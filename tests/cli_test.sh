@@ -537,6 +537,14 @@ if [[ -f $forest ]]; then
   # prtr render shows the .slfc in one pass; PRT's lighting flags and another probe are refused.
   run render "$tmp/cube.slfc" --probe "$forest" --width 16 --height 12 --frames 2 --warmup 0 -o "$tmp/slf.exr" --json -q
   expect_code 0 && [[ $out == *'"mode":"slf"'* && $out == *'"passes":1'* && -s $tmp/slf.exr ]]; check "render: a .slfc renders in one pass" $?
+  for shading in one-pass deferred texture-space; do
+    run render "$tmp/cube.slfc" --probe "$forest" --width 16 --height 12 --frames 1 --warmup 0 --slf-shading $shading -o "$tmp/slf_$shading.exr" --json -q
+    expect_code 0 && [[ $out == *"\"shading\":\"$shading\""* && -s $tmp/slf_$shading.exr ]]; check "render: --slf-shading $shading shades that way" $?
+  done
+  run render "$tmp/cube.slfc" --probe "$forest" --slf-shading sideways -o "$tmp/x.exr" -q
+  expect_code 2 && [[ $err == *--slf-shading* ]]; check "render: an unknown --slf-shading is a usage error naming it" $?
+  run render "$tmp/cube.prtc" --mesh "$tmp/cube.obj" --probe "$forest" --slf-shading deferred -o "$tmp/x.exr" -q
+  expect_code 2 && [[ $err == *--slf-shading* && $err == *--mode* ]]; check "render: --slf-shading on a .prtc is a usage error pointing to --mode" $?
   run render "$tmp/cube.slfc" --probe "$forest" --rotate-deg 30 -o "$tmp/x.exr" -q
   expect_code 2 && [[ $err == *--rotate-deg* && $err == *"surface light field"* ]]; check "render: --rotate-deg on a .slfc is a usage error naming it" $?
   run render "$tmp/cube.slfc" --probe "${forest%forest.exr}city.exr" -o "$tmp/x.exr" -q

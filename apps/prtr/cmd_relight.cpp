@@ -92,6 +92,7 @@ struct Options {
   double degrees = 360.0;
   bool quiet = false, no_video = false, camera_orbit = false;
   std::string exr_pixels = "half", accumulation = "auto", constants = "auto";
+  std::string slf_shading = "auto";  // --kind slf
 };
 
 void add_flags(CLI::App* cmd, Options& o) {
@@ -117,6 +118,10 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_compress_flags(cmd, o.compress, CompressFlagSet::kPipeline);
   add_bake_flags(cmd, o.bake, true);
   add_slf_flags(cmd, o.slf, "--slf-samples");
+  add_checked_option(cmd, "--slf-shading", o.slf_shading,
+                     "--kind slf: where the reconstruction runs (render/slf_renderer.h; auto: "
+                     "per frame, by cost)",
+                     CLI::IsMember(render::kSlfShadingNames.names()));
   add_mesh_flags(cmd, o.mesh_flags);
   add_view_flags(cmd, o.view);
   add_supersample_flag(cmd, o.supersample);
@@ -368,7 +373,7 @@ void check_kind_flags(const Options& o, const CLI::App* cmd) {
           "--kind slf needs --camera-orbit: a surface light field's lighting is baked, so "
           "the environment cannot turn; the camera orbits the mesh instead");
   } else {
-    for (const char* flag : {"--slf-samples", "--charts", "--directions", "--spp"})
+    for (const char* flag : {"--slf-samples", "--charts", "--directions", "--spp", "--slf-shading"})
       if (cmd->count(flag))
         throw UsageError(std::string(flag) + " applies to --kind slf (a surface light field)");
   }
@@ -408,7 +413,9 @@ void run_slf(const Options& o, Clock::time_point start) {
   const render::SlfModel model = slf_render_model(mesh, r.slf);
 
   render::GlContext context(gl);
-  render::SlfRenderer renderer(model, &probe);
+  render::SlfRendererOptions ro;
+  ro.shading = render::kSlfShadingNames.parse(o.slf_shading);
+  render::SlfRenderer renderer(model, &probe, ro);
   renderer.set_background(background);
   const render::Camera big = render::supersampled(camera, o.supersample);
   const Eigen::Vector3d centre = mesh_centre(mesh);

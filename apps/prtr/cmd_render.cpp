@@ -49,6 +49,7 @@ std::string count_list(const std::vector<std::uint64_t>& values) {
 struct Options {
   std::string compressed, probe, mesh, transfer, output, png, mode = "multipass";
   std::string strategy = "order", accumulation = "auto", constants = "auto";
+  std::string slf_shading = "auto";
   ViewFlags view;
   GlFlags gl;
   MeshFlags mesh_flags;
@@ -72,6 +73,10 @@ void add_flags(CLI::App* cmd, Options& o) {
   add_mesh_flags(cmd, o.mesh_flags);
   add_checked_option(cmd, "--mode", o.mode, "Rendering path",
                      CLI::IsMember(render::kModeNames.names()));
+  add_checked_option(cmd, "--slf-shading", o.slf_shading,
+                     "Surface light fields (.slfc): where the reconstruction runs "
+                     "(render/slf_renderer.h; auto: per frame, by cost)",
+                     CLI::IsMember(render::kSlfShadingNames.names()));
   cmd->add_option("--transfer", o.transfer, "Raw transfer file (.prtx), for --mode uncompressed");
   add_checked_option(cmd, "--rotate-deg", o.rotate_deg, "Environment rotation angle (degrees)",
                      angle_degrees());
@@ -241,6 +246,7 @@ void run_slf(const Options& o, CLI::App* cmd) {
   render::GlContext context(gl);
   render::SlfRendererOptions ro;
   ro.cull_back_faces = !o.no_cull;
+  ro.shading = render::kSlfShadingNames.parse(o.slf_shading);
   render::SlfRenderer renderer(model, &probe, ro);
   renderer.set_background(background);
   for (int i = 0; i < o.warmup; ++i) renderer.render(camera);
@@ -267,17 +273,19 @@ void run_slf(const Options& o, CLI::App* cmd) {
                 o.supersample, o.supersample, image_ms);
   }
   if (o.json)
-    std::printf("%s\n", dump_json(Json{{"mode", "slf"},
-                                       {"width", o.view.width},
-                                       {"height", o.view.height},
-                                       {"passes", 1},
-                                       {"clusters", model.clusters},
-                                       {"components", model.components},
-                                       {"fps", median > 0 ? 1000.0 / median : 0.0},
-                                       {"frame_ms_median", median},
-                                       {"supersample", o.supersample},
-                                       {"image_frame_ms", image_ms}})
-                            .c_str());
+    std::printf("%s\n",
+                dump_json(Json{{"mode", "slf"},
+                               {"width", o.view.width},
+                               {"height", o.view.height},
+                               {"passes", 1},
+                               {"shading", render::kSlfShadingNames.name(renderer.shading())},
+                               {"clusters", model.clusters},
+                               {"components", model.components},
+                               {"fps", median > 0 ? 1000.0 / median : 0.0},
+                               {"frame_ms_median", median},
+                               {"supersample", o.supersample},
+                               {"image_frame_ms", image_ms}})
+                    .c_str());
 }
 
 void run(const Options& o, CLI::App* cmd) {
@@ -286,6 +294,9 @@ void run(const Options& o, CLI::App* cmd) {
                                                        {"--mesh", o.mesh},
                                                        {"--transfer", o.transfer}});
   if (is_slfc(o.compressed)) return run_slf(o, cmd);
+  if (cmd->count("--slf-shading"))
+    throw UsageError("--slf-shading applies to surface light fields (.slfc); " + o.compressed +
+                     " is a PRT set: choose its path with --mode");
   const render::GlSelection gl = gl_selection(o.gl);
   render::RendererOptions ro = renderer_options(o, cmd);
   const render::Background background = resolve_background(o.view);
