@@ -415,6 +415,17 @@ const std::pair<render::SlfShading, bool> kVariants[] = {{render::SlfShading::kO
                                                          {render::SlfShading::kDeferred, false},
                                                          {render::SlfShading::kTextureSpace, true}};
 
+// A camera at `eye` looking at the origin, near and far planes around the test scenes.
+render::Camera camera_at(const Vector3d& eye, int width, int height) {
+  render::Camera camera;
+  camera.eye = eye;
+  camera.width = width;
+  camera.height = height;
+  camera.near_plane = 0.5;
+  camera.far_plane = 10;
+  return camera;
+}
+
 TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnEveryPathAndAtThePoles) {
   render::GlContext ctx;
   const render::SlfModel model = scene_model();
@@ -468,12 +479,7 @@ TEST(SlfRenderer, ImageMatchesTheCpuReferenceOnEveryPathAndAtThePoles) {
 TEST(SlfRenderer, NegativeReconstructionRendersClampedOnBothPaths) {
   render::GlContext ctx;
   const render::SlfModel model = negative_scene_model();
-  render::Camera camera;
-  camera.eye = {0.15, 0.1, 3.2};
-  camera.width = 64;
-  camera.height = 48;
-  camera.near_plane = 0.5;
-  camera.far_plane = 10;
+  const render::Camera camera = camera_at({0.15, 0.1, 3.2}, 64, 48);
   const render::Image cpu = render::render_slf_reference(model, camera);
   struct Counts {
     int negative = 0, zero_red = 0, covered = 0;
@@ -668,9 +674,7 @@ TEST(SlfRenderer, TextureSpaceShadesOnlyTheBlocksInViewAndMissesNone) {
   renderer.set_background(background);
   render::SlfReferenceOptions per_texel;
   per_texel.texel_directions = true;
-  render::Camera camera;
-  camera.width = 80;
-  camera.height = 60;
+  render::Camera camera = camera_at(Vector3d::Zero(), 80, 60);
   camera.near_plane = 0.1;
   camera.far_plane = 20;
   const Vector3d eyes[] = {{0.3, 0.2, 3.5}, {-3.2, 1.0, -0.8}, {0.4, -3.4, 0.5}, {0.9, 0.5, 1.2}};
@@ -694,10 +698,7 @@ TEST(SlfRenderer, TextureSpaceShadesOnlyTheBlocksInViewAndMissesNone) {
 TEST(SlfRenderer, TextureSpaceIsCloseToTheFragmentsOwnDirection) {
   render::GlContext ctx;
   const render::SlfModel model = sphere_model();
-  render::Camera camera;
-  camera.eye = {0.3, 0.2, 3.5};
-  camera.width = 80;
-  camera.height = 60;
+  const render::Camera camera = camera_at({0.3, 0.2, 3.5}, 80, 60);
   const render::Image per_fragment = render::render_slf_reference(model, camera);
   render::SlfImageOptions o;
   o.renderer.shading = render::SlfShading::kTextureSpace;
@@ -713,10 +714,7 @@ TEST(SlfRenderer, AutomaticShadingFollowsTheCostOfEachPath) {
   render::GlContext ctx;
   const render::SlfModel model = sphere_model();
   render::SlfRenderer renderer(model, nullptr);
-  render::Camera camera;
-  camera.eye = {0.3, 0.2, 3.5};
-  camera.width = 320;
-  camera.height = 240;
+  render::Camera camera = camera_at({0.3, 0.2, 3.5}, 320, 240);
   for (int frame = 0; frame < 2; ++frame) {
     renderer.render(camera);
     EXPECT_EQ(renderer.shading(), render::SlfShading::kTextureSpace) << frame;
