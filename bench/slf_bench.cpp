@@ -200,15 +200,9 @@ render::SlfModel synthetic_model(const meshes::Mesh& mesh, const Args& a) {
   } else {
     const meshes::Atlas atlas = meshes::make_atlas(mesh, a.map, a.map, {a.charts});
     m.uv = atlas.uv;
-    for (std::size_t texel = 0; texel < atlas.texel_triangle.size(); ++texel) {
-      const std::int32_t t = atlas.texel_triangle[texel];
-      if (t < 0) continue;
-      const Eigen::Vector2f b = atlas.texel_barycentric[texel];
-      const std::size_t c = 3 * std::size_t(t);
-      synthetic.use_texel(m, texel,
-                          (1 - b.x() - b.y()) * m.positions[c] + b.x() * m.positions[c + 1] +
-                              b.y() * m.positions[c + 2]);
-    }
+    const std::vector<Eigen::Vector3f> points = meshes::texel_points(mesh, atlas);
+    for (std::size_t texel = 0; texel < points.size(); ++texel)
+      if (atlas.texel_triangle[texel] >= 0) synthetic.use_texel(m, texel, points[texel]);
   }
   std::uniform_real_distribution<float> view(0.f, 1.f);
   m.view_maps.resize(std::size_t(a.clusters) * std::size_t(a.components + 1) * m.slice_floats());

@@ -129,6 +129,50 @@ TEST(Atlas, TexelCountsFollowAreaAndSamplesLieOnTheirTriangle) {
   }
 }
 
+// Each used texel's point lies on the surface: on a torus (R 1, r 0.35) at the tube's radius
+// from its centre circle, up to the flat faces' departure from it (under 0.025 at 24 x 12,
+// inward where the torus is convex, outward across its saddle); where the
+// texel's centre is inside its triangle's uv, it is the point the centre maps to (solved here
+// from the uv triangle, not from the atlas's barycentrics). Unused texels are the origin; an
+// atlas of another mesh is refused.
+TEST(Atlas, TexelPointsAreTheSurfaceUnderEachTexel) {
+  const Mesh mesh = meshes::make_torus(1.f, 0.35f, 24, 12);
+  const Atlas atlas = meshes::make_atlas(mesh, 128, 128);
+  const std::vector<Eigen::Vector3f> points = meshes::texel_points(mesh, atlas);
+  ASSERT_EQ(points.size(), std::size_t(128 * 128));
+  int used = 0, under_centre = 0;
+  for (std::size_t t = 0; t < points.size(); ++t) {
+    const Eigen::Vector3f p = points[t];
+    const int triangle = atlas.texel_triangle[t];
+    if (triangle < 0) {
+      EXPECT_EQ(p, Eigen::Vector3f::Zero());
+      continue;
+    }
+    ++used;
+    const float tube = std::hypot(Eigen::Vector2f(p.x(), p.z()).norm() - 1.f, p.y());
+    EXPECT_NEAR(tube, 0.35f, 0.025f) << "texel " << t;
+    const Eigen::Vector2f a = atlas.uv[3 * std::size_t(triangle)],
+                          b = atlas.uv[3 * std::size_t(triangle) + 1],
+                          c = atlas.uv[3 * std::size_t(triangle) + 2];
+    const Eigen::Vector2f centre((float(t % 128) + 0.5f) / 128, (float(t / 128) + 0.5f) / 128);
+    Eigen::Matrix2f m;
+    m << (b - a), (c - a);
+    const Eigen::Vector2f w = m.inverse() * (centre - a);
+    if (w.minCoeff() < 1e-4f || w.sum() > 1.f - 1e-4f) continue;
+    ++under_centre;
+    const meshes::Triangle& tri = mesh.triangles[std::size_t(triangle)];
+    const Eigen::Vector3f expected = (1 - w.sum()) * mesh.positions[tri[0]] +
+                                     w.x() * mesh.positions[tri[1]] +
+                                     w.y() * mesh.positions[tri[2]];
+    EXPECT_LT((p - expected).norm(), 1e-4f) << "texel " << t;
+  }
+  EXPECT_GT(used, 128 * 128 / 3);
+  EXPECT_GT(under_centre, used / 2);
+  Mesh fewer = mesh;
+  fewer.triangles.resize(10);
+  EXPECT_THROW(meshes::texel_points(fewer, atlas), std::invalid_argument);
+}
+
 TEST(Atlas, DegenerateTrianglesGetAChartAndOwnTexels) {
   const Mesh mesh = test_mesh();
   const Atlas atlas = meshes::make_atlas(mesh, 128, 96, kPerTriangle);

@@ -629,16 +629,7 @@ render::SlfModel sphere_model() {
   m.grid = {12, 6};
   m.components = 3;
   m.clusters = 6;
-  m.texel_positions.assign(kSide * kSide, Vector3f::Zero());
-  for (std::size_t texel = 0; texel < m.texel_positions.size(); ++texel) {
-    const std::int32_t t = atlas.texel_triangle[texel];
-    if (t < 0) continue;
-    const Vector2f b = atlas.texel_barycentric[texel];
-    const std::size_t c = 3 * std::size_t(t);
-    m.texel_positions[texel] = (1 - b.x() - b.y()) * m.positions[c] + b.x() * m.positions[c + 1] +
-                               b.y() * m.positions[c + 2];
-  }
-  const std::vector<Vector3f> points = m.texel_positions;
+  const std::vector<Vector3f> points = meshes::texel_points(mesh, atlas);
   fill_maps(
       m,
       [&](int x, int y) {

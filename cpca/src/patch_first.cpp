@@ -199,18 +199,13 @@ double equal_patches_overdraw(const Geometry& geometry, int passes, std::uint64_
   if (passes < 1 || std::size_t(passes) > vertices)
     throw std::invalid_argument("equal patches: " + std::to_string(passes) + " passes for " +
                                 std::to_string(vertices) + " vertices");
-  const std::size_t triangles = std::max<std::size_t>(geometry.triangles.size(), 1);
   if (passes == 1) return 1.0;
   const std::vector<Edge> edges = mesh_edges(geometry);
   const std::vector<std::uint32_t> patch_of =
       metis_patches(vertices, edges, std::vector<std::uint32_t>(edges.size(), 1),
                     std::vector<int>(std::size_t(passes), 1), seed, {});
-  std::uint64_t drawn = 0;
-  for (const TriangleIndices& t : geometry.triangles) {
-    const std::uint32_t a = patch_of[t[0]], b = patch_of[t[1]], c = patch_of[t[2]];
-    drawn += 1 + (b != a) + (c != a && c != b);
-  }
-  return double(drawn) / double(triangles);
+  // Each patch a cluster alone in its pass: cpca::overdraw counts the draws.
+  return overdraw(patch_of, geometry.triangles, group_in_order(passes, 1)).average_overdraw;
 }
 
 CompressedSet compress_patch_first(const Eigen::Ref<const DataMatrix>& data,

@@ -201,6 +201,31 @@ std::size_t Atlas::used_texels() const {
                                    [](std::int32_t t) { return t >= 0; }));
 }
 
+std::vector<Eigen::Vector3f> texel_points(const Mesh& mesh, const Atlas& atlas) {
+  const std::size_t texels = std::size_t(atlas.width) * std::size_t(atlas.height);
+  if (atlas.texel_triangle.size() != texels || atlas.texel_barycentric.size() != texels)
+    throw std::invalid_argument("texel points: the atlas names the triangles of " +
+                                std::to_string(atlas.texel_triangle.size()) +
+                                " and the points of " +
+                                std::to_string(atlas.texel_barycentric.size()) + " texels; its " +
+                                std::to_string(atlas.width) + " x " + std::to_string(atlas.height) +
+                                " map has " + std::to_string(texels));
+  std::vector<Eigen::Vector3f> points(texels, Eigen::Vector3f::Zero());
+  for (std::size_t t = 0; t < texels; ++t) {
+    const std::int32_t triangle = atlas.texel_triangle[t];
+    if (triangle < 0) continue;
+    if (std::size_t(triangle) >= mesh.triangle_count())
+      throw std::invalid_argument("texel points: texel " + std::to_string(t) + " names triangle " +
+                                  std::to_string(triangle) + " of " +
+                                  std::to_string(mesh.triangle_count()));
+    const Triangle& tri = mesh.triangles[std::size_t(triangle)];
+    const Eigen::Vector2f b = atlas.texel_barycentric[t];
+    points[t] = (1.f - b.x() - b.y()) * mesh.positions[tri[0]] + b.x() * mesh.positions[tri[1]] +
+                b.y() * mesh.positions[tri[2]];
+  }
+  return points;
+}
+
 Atlas make_atlas(const Mesh& mesh, int width, int height, const AtlasOptions& options) {
   atlas_detail::check_atlas_input(mesh, width, height);
   switch (options.charts) {

@@ -35,11 +35,6 @@ SlfModel slf_model_from_compressed(const meshes::Mesh& mesh, const meshes::Atlas
         "the atlas names the triangles of " + std::to_string(atlas.texel_triangle.size()) +
         " texels; its " + std::to_string(atlas.width) + " x " + std::to_string(atlas.height) +
         " map has " + std::to_string(texels));
-  if (atlas.texel_barycentric.size() != texels)
-    slf_from_compressed_checks::refuse(
-        "the atlas gives the sample points of " + std::to_string(atlas.texel_barycentric.size()) +
-        " texels; its " + std::to_string(atlas.width) + " x " + std::to_string(atlas.height) +
-        " map has " + std::to_string(texels));
   std::size_t owned = 0;
   for (std::int32_t t : atlas.texel_triangle) {
     if (t < -1 || t >= std::int32_t(triangles))
@@ -86,15 +81,10 @@ SlfModel slf_model_from_compressed(const meshes::Mesh& mesh, const meshes::Atlas
   const std::size_t k = std::size_t(set.component_count);
   model.texel_cluster.assign(texels, -1);
   model.texel_weights.assign(texels * k, 0.f);
-  model.texel_positions.assign(texels, Eigen::Vector3f::Zero());
+  model.texel_positions = meshes::texel_points(mesh, atlas);
   std::size_t row = 0;
   for (std::size_t t = 0; t < texels; ++t) {
     if (atlas.texel_triangle[t] < 0) continue;
-    const std::size_t corner = 3 * std::size_t(atlas.texel_triangle[t]);
-    const Eigen::Vector2f b = atlas.texel_barycentric[t];
-    model.texel_positions[t] = (1.f - b.x() - b.y()) * model.positions[corner] +
-                               b.x() * model.positions[corner + 1] +
-                               b.y() * model.positions[corner + 2];
     model.texel_cluster[t] = std::int32_t(set.cluster_of[row]);
     std::copy_n(set.weights.data() + row * k, k, model.texel_weights.data() + t * k);
     ++row;

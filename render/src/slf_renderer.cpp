@@ -334,22 +334,16 @@ struct TexelBlock {
 };
 
 // The blocks holding the texels each triangle's bilinear lookups can read (its uv box, one
-// texel wider on the high side, in texel indices as the lookup floors them).
+// texel wider on the high side, in texel indices as the lookup floors them). Two passes over
+// the triangles: the normals' mean direction and the corners' box first, then the widest
+// angle from that direction.
 std::vector<TexelBlock> texel_blocks(const SlfModel& model) {
   const int columns = (model.map_width + kBlock - 1) / kBlock;
   const int rows = (model.map_height + kBlock - 1) / kBlock;
   const std::size_t count = std::size_t(columns) * std::size_t(rows);
-  std::vector<Eigen::Vector3d> normal_sum(count, Eigen::Vector3d::Zero());
-  std::vector<Eigen::AlignedBox3d> box(count);
-  std::vector<std::vector<std::uint32_t>> readers(count);
   const std::size_t triangles = model.positions.size() / 3;
-  std::vector<Eigen::Vector3d> normals(triangles);
-  for (std::size_t t = 0; t < triangles; ++t) {
-    const Eigen::Vector3d p0 = model.positions[3 * t].cast<double>();
-    const Eigen::Vector3d p1 = model.positions[3 * t + 1].cast<double>();
-    const Eigen::Vector3d p2 = model.positions[3 * t + 2].cast<double>();
-    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
-    normals[t] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+  // Calls visit(block index) for every block triangle t's lookups read.
+  const auto for_each_block = [&](std::size_t t, const auto& visit) {
     double lo_x = 1e30, lo_y = 1e30, hi_x = -1e30, hi_y = -1e30;
     for (int i = 0; i < 3; ++i) {
       const Eigen::Vector2f uv = model.uv[3 * t + std::size_t(i)];
@@ -363,33 +357,44 @@ std::vector<TexelBlock> texel_blocks(const SlfModel& model) {
     const int y0 = std::clamp(int(std::floor(lo_y)), 0, model.map_height - 1) / kBlock;
     const int y1 = std::clamp(int(std::floor(hi_y)) + 1, 0, model.map_height - 1) / kBlock;
     for (int by = y0; by <= y1; ++by)
-      for (int bx = x0; bx <= x1; ++bx) {
-        const std::size_t b = std::size_t(by) * std::size_t(columns) + std::size_t(bx);
-        readers[b].push_back(std::uint32_t(t));
-        normal_sum[b] += normals[t];
-        box[b].extend(p0).extend(p1).extend(p2);
-      }
+      for (int bx = x0; bx <= x1; ++bx)
+        visit(std::size_t(by) * std::size_t(columns) + std::size_t(bx));
+  };
+  std::vector<Eigen::Vector3d> normals(triangles);
+  std::vector<Eigen::Vector3d> normal_sum(count, Eigen::Vector3d::Zero());
+  std::vector<Eigen::AlignedBox3d> box(count);
+  std::vector<bool> read(count, false), unoriented(count, false);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const Eigen::Vector3d p0 = model.positions[3 * t].cast<double>();
+    const Eigen::Vector3d p1 = model.positions[3 * t + 1].cast<double>();
+    const Eigen::Vector3d p2 = model.positions[3 * t + 2].cast<double>();
+    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
+    normals[t] = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+    for_each_block(t, [&](std::size_t b) {
+      read[b] = true;
+      unoriented[b] = unoriented[b] || normals[t].isZero();  // never culled
+      normal_sum[b] += normals[t];
+      box[b].extend(p0).extend(p1).extend(p2);
+    });
   }
+  std::vector<Eigen::Vector3d> axis(count, Eigen::Vector3d::Zero());
+  std::vector<double> lowest(count, 1.0);
+  for (std::size_t b = 0; b < count; ++b)
+    if (normal_sum[b].norm() > 1e-9) axis[b] = normal_sum[b].normalized();
+  for (std::size_t t = 0; t < triangles; ++t)
+    for_each_block(
+        t, [&](std::size_t b) { lowest[b] = std::min(lowest[b], normals[t].dot(axis[b])); });
   std::vector<TexelBlock> blocks;
   for (std::size_t b = 0; b < count; ++b) {
-    if (readers[b].empty()) continue;
+    if (!read[b]) continue;
     TexelBlock block;
     block.x = std::int32_t(b % std::size_t(columns)) * kBlock;
     block.y = std::int32_t(b / std::size_t(columns)) * kBlock;
     block.centre = box[b].center();
     block.radius = 0.5 * box[b].diagonal().norm();
-    const double length = normal_sum[b].norm();
-    bool cone = length > 1e-9;
-    double lowest = 1;
-    if (cone) {
-      block.axis = normal_sum[b] / length;
-      for (std::uint32_t t : readers[b]) {
-        if (normals[t].isZero()) cone = false;  // no orientation: never culled
-        lowest = std::min(lowest, normals[t].dot(block.axis));
-      }
-    }
-    if (cone) {
-      block.cone_cos = std::clamp(lowest, -1.0, 1.0);
+    if (!unoriented[b] && !axis[b].isZero()) {
+      block.axis = axis[b];
+      block.cone_cos = std::clamp(lowest[b], -1.0, 1.0);
       block.cone_sin = std::sqrt(std::max(0.0, 1.0 - block.cone_cos * block.cone_cos));
     }
     blocks.push_back(block);
@@ -412,15 +417,23 @@ bool faces_away(const TexelBlock& block, const Eigen::Vector3d& eye) {
   return distance * cos_gap + block.radius < 0.0;
 }
 
-// Whether a block's sphere lies wholly outside one of the view frustum's planes.
-bool outside_frustum(const TexelBlock& block, const Eigen::Matrix4d& clip_from_world) {
+// The view frustum's six planes (Gribb and Hartmann's rows of the clip matrix), normalised so
+// that n . x + w is the signed distance of x.
+std::vector<Eigen::Vector4d> frustum_planes(const Eigen::Matrix4d& clip_from_world) {
+  std::vector<Eigen::Vector4d> planes;
   for (int axis = 0; axis < 3; ++axis)
     for (double sign : {-1.0, 1.0}) {
       const Eigen::Vector4d plane = clip_from_world.row(3) + sign * clip_from_world.row(axis);
       const double length = plane.head<3>().norm();
-      if (length == 0.0) continue;
-      if ((plane.head<3>().dot(block.centre) + plane.w()) / length < -block.radius) return true;
+      if (length > 0.0) planes.push_back(plane / length);
     }
+  return planes;
+}
+
+// Whether a block's sphere lies wholly outside one of the planes.
+bool outside_frustum(const TexelBlock& block, const std::vector<Eigen::Vector4d>& planes) {
+  for (const Eigen::Vector4d& plane : planes)
+    if (plane.head<3>().dot(block.centre) + plane.w() < -block.radius) return true;
   return false;
 }
 
@@ -442,8 +455,11 @@ struct SlfRenderer::Impl {
   void draw(const Camera& camera);
   void draw_deferred(const Camera& camera);
   void draw_mesh(GlProgram& with, const Camera& camera);
-  // Texture space: the blocks in view, in `visible_blocks` (x, y pairs).
+  // Texture space: the blocks in view, in `visible_blocks` (x, y pairs), and their texels.
   void find_visible_blocks(const Camera& camera);
+  long long texels_in_view() const {
+    return (long long)(visible_blocks.size() / 2) * slf_gl::kBlock * slf_gl::kBlock;
+  }
   void shade_texels(const Camera& camera);
   SlfShading choose(const Camera& camera);
   void bind_textures();
@@ -601,7 +617,7 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
   if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
     throw GlError("surface light field: this context cannot render into a " +
                   std::to_string(x_size) + " x " + std::to_string(y_size) +
-                  " RGBA32F radiance map; use --shading one-pass or deferred");
+                  " RGBA32F radiance map; use --slf-shading one-pass or deferred");
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
   blocks = slf_gl::texel_blocks(model);
   glGenVertexArrays(1, &block_vao);
@@ -742,10 +758,10 @@ void SlfRenderer::Impl::draw_mesh(GlProgram& with, const Camera& camera) {
 
 void SlfRenderer::Impl::find_visible_blocks(const Camera& camera) {
   visible_blocks.clear();
-  const Eigen::Matrix4d clip = camera.clip_from_world();
+  const std::vector<Eigen::Vector4d> planes = slf_gl::frustum_planes(camera.clip_from_world());
   for (const slf_gl::TexelBlock& block : blocks) {
     if (options.cull_back_faces && slf_gl::faces_away(block, camera.eye)) continue;
-    if (slf_gl::outside_frustum(block, clip)) continue;
+    if (slf_gl::outside_frustum(block, planes)) continue;
     visible_blocks.push_back(block.x);
     visible_blocks.push_back(block.y);
   }
@@ -783,7 +799,7 @@ SlfShading SlfRenderer::Impl::choose(const Camera& camera) {
     return screen;
   find_visible_blocks(camera);
   if (options.shading == SlfShading::kTextureSpace) return SlfShading::kTextureSpace;
-  const long long texels = (long long)(visible_blocks.size() / 2) * slf_gl::kBlock * slf_gl::kBlock;
+  const long long texels = texels_in_view();
   // A frame of another size says little about this one's fragments.
   if (camera.width != counted_width || camera.height != counted_height) last_samples = -1;
   const long long fragments =
@@ -861,8 +877,7 @@ const SlfRendererOptions& SlfRenderer::options() const {
 }
 
 long long SlfRenderer::texels_shaded() const {
-  if (impl_->last != SlfShading::kTextureSpace) return 0;
-  return (long long)(impl_->visible_blocks.size() / 2) * slf_gl::kBlock * slf_gl::kBlock;
+  return impl_->last == SlfShading::kTextureSpace ? impl_->texels_in_view() : 0;
 }
 
 long long SlfRenderer::texels_in_blocks() const {

@@ -56,6 +56,11 @@ struct Atlas {
   std::size_t used_texels() const;
 };
 
+// Per texel, the surface point it samples (its triangle at its barycentrics); (0, 0, 0) where
+// no triangle reads it. `mesh` is the one the atlas was made from (std::invalid_argument
+// when the sizes say otherwise).
+std::vector<Eigen::Vector3f> texel_points(const Mesh& mesh, const Atlas& atlas);
+
 // An atlas of at most width x height texels, the same for the same mesh and options. Throws
 // std::invalid_argument when the size is out of range or too small to hold every chart.
 Atlas make_atlas(const Mesh& mesh, int width, int height, const AtlasOptions& options = {});
