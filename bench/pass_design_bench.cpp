@@ -16,6 +16,7 @@
 #include "meshes/load.h"
 #include "prt/transfer_file.h"
 
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 #include <string>
@@ -39,7 +40,8 @@ struct Row {
 };
 
 Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOptions o,
-        const std::string& row, int per_pass, double reference_se) {
+        const std::string& row, int per_pass, double reference_se,
+        std::vector<std::uint32_t>& reference_clusters) {
   o.clusters_per_pass = per_pass;
   if (row == "original") {
     o.method = cpca::ClusterMethod::kLbg;
@@ -52,6 +54,7 @@ Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOption
     const auto fields = split_on(row, ':');
     if (fields.size() > 1) o.error_slack = std::stod(fields[1]);
     o.error_target = reference_se;
+    if (reference_se > 0) o.reference_clusters = reference_clusters;
   } else {
     o.method = row.rfind("patch-joint", 0) == 0 ? cpca::ClusterMethod::kPatchJoint
                                                 : cpca::ClusterMethod::kJoint;
@@ -61,6 +64,7 @@ Row run(const cpca::DataMatrix& x, const cpca::Geometry& g, cpca::CompressOption
   }
   cpca::CompressReport report;
   const cpca::CompressedSet set = cpca::compress(x, o, &g, &report);
+  if (row == "original") reference_clusters = set.cluster_of;
   Row r;
   r.seconds = report.clustering_seconds() + report.pca_seconds;
   r.se = cpca::error_metrics(x, set).average_squared_error;
@@ -106,9 +110,10 @@ int main(int argc, char** argv) {
   for (const std::string& k : ks) {
     o.clusters = std::stoi(k);
     double original_se = 0;
+    std::vector<std::uint32_t> original_clusters;
     for (const std::string& per_pass : per_passes)
       for (const std::string& row : rows) {
-        const Row r = run(x, g, o, row, std::stoi(per_pass), original_se);
+        const Row r = run(x, g, o, row, std::stoi(per_pass), original_se, original_clusters);
         if (row == "original") original_se = r.se;
         std::printf("| %s | %s | %s | %.2f | %.4e | %.3f | %.3f |\n", k.c_str(), per_pass.c_str(),
                     row.c_str(), r.seconds, r.se, original_se > 0 ? r.se / original_se : 0.0,

@@ -263,7 +263,8 @@ CompressCacheResult cached_compress(const fs::path& transfer_path, const meshes:
     key << " per-pass " << o.clusters_per_pass << " lambda " << o.lambda;
   if (o.method == cpca::ClusterMethod::kPatchEpsilon)
     key << " per-pass " << o.clusters_per_pass << " eps " << o.error_slack << " target "
-        << o.error_target << " density " << reference_hash(o.reference_clusters);
+        << o.error_target << " density " << reference_hash(o.reference_clusters)
+        << " border-cuts bounded";  // the search with border cuts gives other clusters
   if (o.overdraw_cap > 0) key << " cap " << o.overdraw_cap;
   const std::string stem = "cpca-" + hex(hash_text(key.str()));
   CompressCacheResult r;

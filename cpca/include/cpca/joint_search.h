@@ -44,11 +44,13 @@ struct JointSearchOptions {
   // > 0: the epsilon-constraint search (Haimes, Lasdon & Wismer 1971) instead: minimise the
   // triangles drawn subject to Average SE <= error_target. lambda and overdraw_cap are then
   // unused: the price of a drawn triangle is a multiplier the search adapts (halved while the
-  // error is above the target, quadrupled while more than 1% of the allowance is unspent).
-  // Its moves are bounded (a vertex considers the clusters of its pass and of its 1-ring, and
-  // the nearest means only while the error is above the target), and its refits start from
-  // the previous bases (refit_tolerance). Stops after max_steps or 3 steps in a row that move
-  // neither draws nor error by `threshold`.
+  // error is above the target or the moves the target refused would overspend it by more
+  // than 1%, quadrupled while more than 1% of the allowance is unspent). Its moves are
+  // bounded (a vertex considers the clusters of its pass and of its 1-ring, and the nearest
+  // means only while the error is above the target); after the vertex moves, every border
+  // between two passes is relabelled at once by a minimum cut (border_cut.h); its refits
+  // start from the previous bases (refit_tolerance). Stops after max_steps or 3 steps in a
+  // row that move neither the extra draws nor the error by `threshold`.
   double error_target = 0.0;
   double refit_tolerance = 1e-6;  // the bases are stored as floats
 };
