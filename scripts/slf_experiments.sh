@@ -8,17 +8,25 @@
 # 4096-path prtr path-trace, over every covered pixel and over those 2 and 5 pixels inside
 # the outline (prtr compare --erode: the grazing rim left out). Writes OUT_DIR/table.md and OUT_DIR/side_by_side.png
 # (reference | SLF | PRT 10 | PRT 6).
-# Usage: scripts/slf_experiments.sh [OUT_DIR]  (default out/slf). PRTR: the binary.
+# Usage: [PROBE=PROBE] [MESH=MESH] scripts/slf_experiments.sh [OUT_DIR]  (default out/slf).
+# PRTR: the binary. PROBE: the light probe (default the forest probe above). MESH: a mesh
+# in place of the icosphere (e.g. /usr/share/glmark2/models/bunny.obj); its PRT rows use
+# K 256 instead of 64, the SLF row is the same.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 prtr=${PRTR:-./build/prtr}
 out=${1:-out/slf}
-probe=/usr/share/blender/datafiles/studiolights/world/forest.exr
+probe=${PROBE:-/usr/share/blender/datafiles/studiolights/world/forest.exr}
 mkdir -p "$out"
 material=(--material cook-torrance --roughness 0.1 --specular 0.5 --albedo 0.3)
 view=(--width 320 --height 240)
-# An icosahedron split three times and pushed onto the unit sphere.
-python3 - "$out/sphere.obj" <<'PY'
+mesh=${MESH:-}
+clusters=256
+if [[ -z $mesh ]]; then
+  mesh=$out/sphere.obj
+  clusters=64
+  # An icosahedron split three times and pushed onto the unit sphere.
+  python3 - "$mesh" <<'PY'
 import math, sys
 t = (1 + 5 ** 0.5) / 2
 v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
@@ -44,18 +52,19 @@ with open(sys.argv[1], "w") as o:
     o.writelines("v %f %f %f\n" % p for p in v)
     o.writelines("f %d %d %d\n" % (a + 1, b + 1, c + 1) for a, b, c in f)
 PY
-mesh=$out/sphere.obj
+fi
+name=$(basename "${mesh%.*}")
 "$prtr" path-trace "$mesh" --probe "$probe" "${material[@]}" "${view[@]}" --spp 4096 --seed 3 \
   -o "$out/reference.exr" --png "$out/reference.png" -q
 "$prtr" path-trace "$mesh" --probe "$probe" "${material[@]}" "${view[@]}" --spp 256 --seed 2 \
   -o "$out/reference256.exr" -q
 "$prtr" slf "$mesh" --probe "$probe" "${material[@]}" --samples 256x256 --directions 32x16 \
-  --spp 16 --clusters 256 --pcs 8 --no-cache -o "$out/sphere.slfc" -q | tee "$out/slf.txt"
-"$prtr" render "$out/sphere.slfc" --probe "$probe" "${view[@]}" -o "$out/slf.exr" \
+  --spp 16 --clusters 256 --pcs 8 --no-cache -o "$out/$name.slfc" -q | tee "$out/slf.txt"
+"$prtr" render "$out/$name.slfc" --probe "$probe" "${view[@]}" -o "$out/slf.exr" \
   --png "$out/slf.png" -q
 for n in 6 10; do
   "$prtr" bake "$mesh" "${material[@]}" --order $n --bounces 1 -o "$out/prt$n.prtx" -q
-  "$prtr" compress "$out/prt$n.prtx" --mesh "$mesh" --clusters 64 --pcs 8 -o "$out/prt$n.prtc" -q
+  "$prtr" compress "$out/prt$n.prtx" --mesh "$mesh" --clusters $clusters --pcs 8 -o "$out/prt$n.prtc" -q
   "$prtr" render "$out/prt$n.prtc" --probe "$probe" "${view[@]}" -o "$out/prt$n.exr" \
     --png "$out/prt$n.png" -q
 done
