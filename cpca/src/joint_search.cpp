@@ -505,7 +505,8 @@ std::int64_t cut_borders(const Candidates& cand, SweepState& s, double cap, doub
     for (std::size_t n = 0; n < free.size(); ++n) old_cluster[n] = s.cluster_of[free[n]];
     // At the step's price first; when that cut would overspend the allowance, at a quarter of
     // it, and so on: the pair's own dual, so the last of the allowance is still spent.
-    for (double mu = s.mu, tries = 0; tries < 6; mu *= 0.25, ++tries) {
+    double mu = s.mu;
+    for (int tries = 0; tries < 6; mu *= 0.25, ++tries) {
       const std::vector<std::uint8_t> label = cut_border(terms, err_a, err_b, mu);
       double de = 0;
       std::uint64_t changed = 0;
