@@ -458,6 +458,18 @@ std::int64_t cut_borders(const Candidates& cand, SweepState& s, double cap, doub
   std::vector<std::uint32_t> stamp(s.triangles.size(), ~0u);
   std::vector<std::uint32_t> free, touched, best_a, best_b, old_cluster;
   std::vector<double> err_a, err_b, own_err;
+  // Passes the touched triangles meet, summed; and free vertex n into cluster c.
+  const auto draws_of = [&s](const std::vector<std::uint32_t>& ts) {
+    std::int64_t n = 0;
+    for (std::uint32_t t : ts)
+      n +=
+          distinct(s.pass(s.triangles[t][0]), s.pass(s.triangles[t][1]), s.pass(s.triangles[t][2]));
+    return n;
+  };
+  const auto relabel = [&s, &free](std::size_t n, std::uint32_t c) {
+    --s.size[s.cluster_of[free[n]]], ++s.size[c];
+    s.cluster_of[free[n]] = c;
+  };
   std::int64_t saved = 0;
   std::uint32_t pair_id = 0;
   for (std::size_t i = 0; i < listed.size(); ++pair_id) {
@@ -491,14 +503,11 @@ std::int64_t cut_borders(const Candidates& cand, SweepState& s, double cap, doub
       continue;
     }
     touched.clear();
-    std::int64_t drawn_before = 0;
     for (std::uint32_t p : free)
       for (std::uint32_t k = s.incident.offset[p]; k < s.incident.offset[p + 1]; ++k)
-        if (const std::uint32_t t = s.incident.triangle[k]; stamp[t] != pair_id) {
+        if (const std::uint32_t t = s.incident.triangle[k]; stamp[t] != pair_id)
           stamp[t] = pair_id, touched.push_back(t);
-          const TriangleIndices& tri = s.triangles[t];
-          drawn_before += distinct(s.pass(tri[0]), s.pass(tri[1]), s.pass(tri[2]));
-        }
+    const std::int64_t drawn_before = draws_of(touched);
     const BorderTerms terms = border_terms(s.triangles, touched, node_of, s.cluster_of, s.pass_of,
                                            a, b, int(free.size()));
     old_cluster.resize(free.size());
@@ -514,14 +523,9 @@ std::int64_t cut_borders(const Candidates& cand, SweepState& s, double cap, doub
         const std::uint32_t c = label[n] ? best_b[n] : best_a[n];
         de += (label[n] ? err_b[n] : err_a[n]) - own_err[n];
         changed += c != old_cluster[n];
-        --s.size[s.cluster_of[free[n]]], ++s.size[c];
-        s.cluster_of[free[n]] = c;
+        relabel(n, c);
       }
-      std::int64_t drawn_after = 0;
-      for (std::uint32_t t : touched) {
-        const TriangleIndices& tri = s.triangles[t];
-        drawn_after += distinct(s.pass(tri[0]), s.pass(tri[1]), s.pass(tri[2]));
-      }
+      const std::int64_t drawn_after = draws_of(touched);
       bool emptied = false;
       for (std::size_t n = 0; n < free.size() && !emptied; ++n)
         emptied = s.size[old_cluster[n]] == 0;
@@ -535,10 +539,7 @@ std::int64_t cut_borders(const Candidates& cand, SweepState& s, double cap, doub
         moves += changed;
         break;
       }
-      for (std::size_t n = 0; n < free.size(); ++n) {
-        --s.size[s.cluster_of[free[n]]], ++s.size[old_cluster[n]];
-        s.cluster_of[free[n]] = old_cluster[n];
-      }
+      for (std::size_t n = 0; n < free.size(); ++n) relabel(n, old_cluster[n]);
       if (tries == 0 && !within) s.wanted += de;
       if (within || changed == 0) break;  // a lower price only buys less
     }
