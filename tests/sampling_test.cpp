@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 namespace {
 
@@ -81,6 +82,42 @@ TEST(Sampling, RandomRotationIsARotation) {
     const Eigen::Matrix3d r = prt::random_rotation(rng);
     EXPECT_LT((r * r.transpose() - Eigen::Matrix3d::Identity()).norm(), 1e-12);
     EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+  }
+}
+
+TEST(Sampling, Sobol02StartsAsSobolsSequence) {
+  // Sobol's first two dimensions in index order (not Gray-code order): the radical inverse
+  // 0, 1/2, 1/4, 3/4, 1/8, 5/8 and the Pascal matrix's 0, 1/2, 3/4, 1/4, 5/8, 1/8.
+  const double x[] = {0, 0.5, 0.25, 0.75, 0.125, 0.625};
+  const double y[] = {0, 0.5, 0.75, 0.25, 0.625, 0.125};
+  for (std::uint32_t i = 0; i < 6; ++i) {
+    EXPECT_EQ(prt::sobol02(i, 0, 0).x(), x[i]) << i;
+    EXPECT_EQ(prt::sobol02(i, 0, 0).y(), y[i]) << i;
+  }
+}
+
+TEST(Sampling, Sobol02BlocksAreNetsUnderAnyShift) {
+  // A (0, m, 2)-net: every aligned block of 2^m points, shifted or not, puts exactly one point
+  // in each 2^-a x 2^-(m-a) box, for every a; the defining property of a (0, 2)-sequence.
+  prt::Pcg32 rng(9);
+  for (int m = 0; m <= 8; ++m) {
+    const std::uint32_t n = 1u << m;
+    for (const std::uint32_t block : {0u, 1u, 7u, 1000003u}) {
+      const std::uint32_t shift_x = block == 0 ? 0 : rng.next_u32();
+      const std::uint32_t shift_y = block == 0 ? 0 : rng.next_u32();
+      for (int a = 0; a <= m; ++a) {
+        std::vector<int> count(n, 0);
+        for (std::uint32_t i = 0; i < n; ++i) {
+          const Eigen::Vector2d p = prt::sobol02(block * n + i, shift_x, shift_y);
+          ASSERT_TRUE(p.x() >= 0 && p.x() < 1 && p.y() >= 0 && p.y() < 1);
+          const auto bx = std::uint32_t(p.x() * double(1u << a));
+          const auto by = std::uint32_t(p.y() * double(1u << (m - a)));
+          ++count[(bx << (m - a)) | by];
+        }
+        for (std::uint32_t box = 0; box < n; ++box)
+          ASSERT_EQ(count[box], 1) << "m " << m << " a " << a << " block " << block;
+      }
+    }
   }
 }
 

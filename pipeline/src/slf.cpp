@@ -30,7 +30,9 @@ void hash_value(std::uint64_t& h, const T& value) {
 
 std::uint64_t bake_key(const meshes::Mesh& mesh, const probes::Probe& probe, const SlfSettings& s) {
   std::uint64_t h = common::kFnvOffset;
-  hash_value(h, std::uint32_t(3));  // this key's layout
+  // The key's layout and the estimator's version (4: shared light samples' views from a
+  // (0, 2)-sequence), so a bake by an older estimator is not reused.
+  hash_value(h, std::uint32_t(4));
   hash_value(h, meshes::content_hash(mesh));
   hash_value(h, prt::probe_hash(probe));
   const prt::SlfBakeOptions& o = s.bake;

@@ -34,6 +34,21 @@ double Pcg32::next_double() {
   return static_cast<double>(((hi << 32) | lo) >> 11) * 0x1.0p-53;
 }
 
+Eigen::Vector2d sobol02(std::uint32_t i, std::uint32_t shift_x, std::uint32_t shift_y) {
+  std::uint32_t x = i;  // bit reversal: bit k of i becomes the k-th binary digit
+  x = (x << 16) | (x >> 16);
+  x = ((x & 0x00FF00FFu) << 8) | ((x >> 8) & 0x00FF00FFu);
+  x = ((x & 0x0F0F0F0Fu) << 4) | ((x >> 4) & 0x0F0F0F0Fu);
+  x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+  x = ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+  // The Pascal matrix mod 2: column k (bit k of i) holds binomial(k, r) in digit r.
+  std::uint32_t y = 0;
+  for (std::uint32_t column = 1u << 31; i != 0; i >>= 1, column ^= column >> 1)
+    if (i & 1u) y ^= column;
+  constexpr double kUnit = 0x1.0p-32;
+  return {double(x ^ shift_x) * kUnit, double(y ^ shift_y) * kUnit};
+}
+
 namespace {
 
 void check_count(int count) {

@@ -5,6 +5,7 @@
 #include "prt/slf_bake.h"
 
 #include "prt/path_tracer.h"
+#include "prt/sampling.h"
 
 #include "common/atomic_file.h"
 #include "common/binary_file.h"
@@ -277,20 +278,23 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       queries.push_back(q);
     }
     if (ratio > 0) {
-      // View stratum p takes light sample (first + p) mod count: a random rotation, so that
-      // every pairing of strata is equally likely (the sum is unbiased) and no view stratum
-      // keeps one light sample. Unlit samples need no view.
+      // Light sample l is paired with view l of a digitally shifted (0, 2)-sequence over the
+      // cell. The probe's samples are stratified along its CDF, so a bright source (a sun)
+      // takes a run of consecutive l, and the sequence spreads any such run over the whole
+      // cell; pairing sample l with stratum l plus a random rotation gave the run a strip of
+      // the cell, a quarter of its polar range for 64 samples. Each view is uniform over the
+      // cell and drawn apart from its light sample, so the sum stays unbiased. Unlit samples
+      // need no view.
       RandomStream jitter{mix_key(column_key, 0x11647ULL), 0};
-      const std::size_t first =
-          std::min(std::size_t(shared) - 1, std::size_t(jitter.next() * shared));
+      const auto shift_x = std::uint32_t(jitter.next() * 0x1.0p32);
+      const auto shift_y = std::uint32_t(jitter.next() * 0x1.0p32);
       views.clear();
       lights_of.clear();
-      for (int p = 0; p < shared; ++p) {
-        const std::size_t l = (first + std::size_t(p)) % std::size_t(shared);
+      for (std::uint32_t l = 0; l < std::uint32_t(shared); ++l) {
         if (!lights.lit(l)) continue;
-        const Eigen::Vector2d ab = stratified_point(p, shared, jitter);
+        const Eigen::Vector2d ab = sobol02(l, shift_x, shift_y);
         views.push_back(cell_direction(o.grid, cell, ab.x(), ab.y()));
-        lights_of.push_back(std::uint32_t(l));
+        lights_of.push_back(l);
       }
       sums[std::size_t(column)] +=
           tracer.shared_light_sum(point, lights, views, lights_of, ratio) / o.light_samples;

@@ -49,4 +49,12 @@ double cosine_hemisphere_pdf(const Eigen::Vector3d& direction);
 // A rotation drawn uniformly from SO(3) (Shoemake's uniform quaternion).
 Eigen::Matrix3d random_rotation(Pcg32& rng);
 
+// Point i of the (0, 2)-sequence in base 2 (Sobol's first two dimensions: van der Corput's
+// radical inverse and the Pascal matrix's), its coordinates' bits XORed with `shift` (a
+// random digital shift; Kollig & Keller 2002). With a uniform shift every point is uniform
+// over [0, 1)^2, and any 2^m points i = k 2^m .. (k + 1) 2^m - 1 still put one point in each
+// 2^-a x 2^-(m-a) box of the square: a run of consecutive indices is spread over the whole
+// square, not over a strip of it.
+Eigen::Vector2d sobol02(std::uint32_t i, std::uint32_t shift_x, std::uint32_t shift_y);
+
 }  // namespace prt

@@ -12,9 +12,10 @@
 // radiance of the most grazing view above it (prt::clamp_to_horizon), so silhouettes do not
 // go dark. With `light_samples` (default 4) the paths' first light sample comes from
 // light_samples x spp probe samples the texel traces once and every cell reuses, each paired
-// with a view of its own (prt::SharedLights): for the glossy bunny and horse under the forest
-// probe the noise of the cells in front of their texel falls from 27 to 15 % in about the
-// same time (docs/BENCHMARKS.md, "Bake noise").
+// with a view of its own, spread over the cell by a (0, 2)-sequence (prt::SharedLights,
+// prt::sobol02): for the glossy bunny and horse under the forest probe the noise of the cells
+// in front of their texel falls from 27 to 15 % in about the same time (docs/BENCHMARKS.md,
+// "Bake noise").
 //
 // The .slf file holds the matrix (or a range of its rows, for processes that bake parts)
 // after a 128-byte versioned header (common/binary_file.h), little-endian:
