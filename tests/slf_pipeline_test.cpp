@@ -8,6 +8,7 @@
 #include "pipeline/slf.h"
 #include "pipeline/slf_file.h"
 #include "probes/procedural.h"
+#include "prt/slf_filter.h"
 #include "test_support.h"
 
 #include <gtest/gtest.h>
@@ -75,10 +76,12 @@ TEST(SlfPipeline, ErrorFiguresMatchCpcaAndTheWrittenFile) {
   EXPECT_EQ(read.set.means, slf.set.means);
   EXPECT_EQ(read.set.bases, slf.set.bases);
 
-  // The file reconstructs the bake as closely as the run said: bake again (deterministic)
-  // and compare.
+  // The file reconstructs the bake, after the texel filter, as closely as the run said: bake
+  // and filter again (deterministic) and compare.
   const meshes::Atlas atlas = meshes::make_atlas(scene.mesh, 24, 24);
-  const prt::SlfMatrix matrix = prt::bake_slf(scene.mesh, atlas, scene.probe, settings().bake);
+  prt::SlfMatrix matrix = prt::bake_slf(scene.mesh, atlas, scene.probe, settings().bake);
+  ASSERT_EQ(settings().filter.radius, 1);
+  prt::filter_slf_texels(matrix, scene.mesh, atlas, settings().filter);
   double error = 0;
   std::vector<float> row(54);
   for (std::uint64_t r = 0; r < matrix.shape.row_count; ++r) {

@@ -140,7 +140,7 @@ pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probe
       const double bake_seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       r = pipeline::compress_slf(mesh, o.mesh, probe_name, std::move(matrix), settings.compress,
-                                 stderr_reporter(quiet));
+                                 settings.filter, stderr_reporter(quiet));
       r.bake_seconds = bake_seconds;
       pipeline::write_slfc(o.output, r.slf);
       for (const fs::path& p : parts) fs::remove(p);

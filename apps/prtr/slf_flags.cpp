@@ -45,6 +45,11 @@ void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
                      "shared by all of a texel's cells (one shadow ray each; 0: every path its "
                      "own)",
                      integer_in(0, prt::kMaxLightSamples));
+  add_checked_option(cmd, "--texel-filter", f.texel_filter,
+                     "Surface light field: before compression, smooth each texel with its "
+                     "neighbours within this many texels on the same chart and facing within 20 "
+                     "degrees (cross-bilateral; trades bake noise for blur; 0: off)",
+                     integer_in(0, 8));
 }
 
 void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
@@ -55,6 +60,7 @@ void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
       parse_size(f.directions, "--directions", 1, 4096);
   settings.bake.spp = f.spp;
   settings.bake.light_samples = f.light_samples;
+  settings.filter.radius = f.texel_filter;
 }
 
 void check_slf_settings(const pipeline::SlfSettings& settings) {

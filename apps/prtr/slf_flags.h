@@ -18,6 +18,7 @@ struct SlfFlags {
               charts = std::string(meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal));
   int spp = 16;
   int light_samples = prt::SlfBakeOptions{}.light_samples;
+  int texel_filter = prt::SlfFilterOptions{}.radius;
   const char* samples_flag = "--samples";  // the atlas size's flag name, for messages
 };
 

@@ -6,6 +6,7 @@
 #include "common/hash.h"
 #include "meshes/atlas.h"
 #include "pipeline/pipeline.h"
+#include "prt/slf_filter.h"
 
 #include <tbb/parallel_for.h>
 
@@ -62,6 +63,7 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
                 const std::string& probe_name, SlfSettings settings, const fs::path& cache_dir,
                 const Reporter& reporter) {
   settings.bake.validate();
+  settings.filter.validate();
   const meshes::Atlas atlas =
       meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
   const std::uint64_t rows = atlas.used_texels();
@@ -123,8 +125,8 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
     }
   }
   const double bake_seconds = seconds_since(bake_start);
-  SlfRun compressed =
-      compress_slf(mesh, mesh_path, probe_name, std::move(matrix), settings.compress, reporter);
+  SlfRun compressed = compress_slf(mesh, mesh_path, probe_name, std::move(matrix),
+                                   settings.compress, settings.filter, reporter);
   compressed.bake_seconds = bake_seconds;
   compressed.bake_cached = run.bake_cached;
   compressed.bake_path = run.bake_path;
@@ -133,7 +135,8 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
 
 SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
                     const std::string& probe_name, prt::SlfMatrix matrix,
-                    cpca::CompressOptions compress, const Reporter& reporter) {
+                    cpca::CompressOptions compress, const prt::SlfFilterOptions& filter,
+                    const Reporter& reporter) {
   SlfRun run;
   const std::uint64_t count = matrix.shape.row_count;
   const std::size_t columns = matrix.shape.columns();
@@ -141,6 +144,13 @@ SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
     throw std::invalid_argument("compress_slf: the matrix holds " +
                                 std::to_string(matrix.data.size()) + " floats, not " +
                                 std::to_string(count) + " rows x " + std::to_string(columns));
+  filter.validate();
+  if (filter.radius > 0 && matrix.shape.first_row == 0 &&
+      matrix.shape.row_count == matrix.shape.rows) {
+    const meshes::Atlas atlas = meshes::make_atlas(
+        mesh, matrix.shape.atlas_width, matrix.shape.atlas_height, {matrix.shape.charts});
+    prt::filter_slf_texels(matrix, mesh, atlas, filter);
+  }
   compress.layout = {1, 3, matrix.shape.grid.directions()};
   const Eigen::Map<const cpca::DataMatrix> data(matrix.data.data(), Eigen::Index(count),
                                                 Eigen::Index(columns));

@@ -15,6 +15,7 @@
 #include "pipeline/slf_file.h"
 #include "probes/probe.h"
 #include "prt/slf_bake.h"
+#include "prt/slf_filter.h"
 
 #include <filesystem>
 #include <string>
@@ -26,6 +27,9 @@ struct SlfSettings {
   meshes::AtlasCharts charts = meshes::AtlasCharts::kConformal;
   prt::SlfBakeOptions bake;        // its progress callback is replaced by the reporter's
   cpca::CompressOptions compress;  // its layout is set to the SLF's (pipeline/slf_file.h)
+  // Applied to the bake before compression (the cache keeps the bake unfiltered); only to a
+  // whole matrix, not to a range of rows.
+  prt::SlfFilterOptions filter;
 };
 
 struct SlfRun {
@@ -35,8 +39,8 @@ struct SlfRun {
   bool bake_cached = false;
   std::filesystem::path bake_path;  // the cache entry, empty without a cache
   cpca::CompressReport report;
-  // Root mean square over all entries of the reconstruction minus the baked matrix, and
-  // the same relative to the matrix's own RMS.
+  // Root mean square over all entries of the reconstruction minus the matrix compressed
+  // (the bake after the texel filter), and the same relative to that matrix's own RMS.
   double rms_error = 0, relative_rms_error = 0;
   // Floats: V x D raw against V N + K (N + 1) D compressed (cluster ids not counted, as in
   // cpca's SizeMetrics), and their ratio.
@@ -51,12 +55,14 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
                 const std::string& probe_name, SlfSettings settings,
                 const std::filesystem::path& cache_dir, const Reporter& reporter);
 
-// The compression half of make_slf: CPCA of a baked matrix (its shape says which rows) and
-// the figures, for a matrix baked elsewhere (prtr slf under mpirun joins the ranks' parts).
+// The compression half of make_slf: the texel filter (a whole matrix only; its atlas made
+// again from the mesh and the matrix's shape), CPCA of the matrix (its shape says which rows)
+// and the figures, for a matrix baked elsewhere (prtr slf under mpirun joins the ranks' parts).
 // The bake fields of the result are left at zero. Throws std::invalid_argument for bad
 // options (more clusters than rows) and a matrix whose data does not match its shape.
 SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
                     const std::string& probe_name, prt::SlfMatrix matrix,
-                    cpca::CompressOptions compress, const Reporter& reporter);
+                    cpca::CompressOptions compress, const prt::SlfFilterOptions& filter,
+                    const Reporter& reporter);
 
 }  // namespace pipeline
