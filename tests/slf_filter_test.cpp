@@ -2,7 +2,8 @@
 // divides independent noise's variance by sum(w)^2 / sum(w^2) of its Gaussian weights (the
 // analytic figure for a weighted mean) wherever its whole window lies on the chart; texels
 // of different charts never mix; a normal limit below the mesh's turn between texels leaves
-// the matrix as it was; radius 0 changes nothing; bad options and a partial matrix are refused.
+// the matrix nearly as it was, and a texel without a normal keeps its value; radius 0
+// changes nothing; bad options and a partial matrix are refused.
 #include "prt/slf_filter.h"
 
 #include "meshes/atlas.h"
@@ -122,6 +123,12 @@ TEST(SlfFilter, TheNormalLimitKeepsTurningTexelsApart) {
   const double tight = changed(0.01f), loose = changed(20.f);
   EXPECT_GT(loose, 0.95);
   EXPECT_LT(tight, 0.5 * loose);
+  // A texel with no normal (a degenerate mesh) keeps its own value rather than none.
+  meshes::Mesh flat = mesh;
+  for (meshes::Vec3& n : flat.normals) n = meshes::Vec3::Zero();
+  m.data = before;
+  prt::filter_slf_texels(m, flat, atlas, {2, 20.f});
+  EXPECT_EQ(m.data, before);
   // Radius 0 is no filter.
   m.data = before;
   prt::filter_slf_texels(m, mesh, atlas, {0, 20.f});

@@ -87,7 +87,10 @@ void filter_slf_texels(SlfMatrix& m, const meshes::Mesh& mesh, const meshes::Atl
           const std::int64_t nx = std::int64_t(x) + dx;
           if (nx < 0 || nx >= std::int64_t(width)) continue;
           const std::size_t n = std::size_t(ny) * width + std::size_t(nx);
-          if (row_of[n] < 0 || chart[n] != chart[t] || normal[n].dot(normal[t]) < min_cos) continue;
+          // The texel itself always counts, even with a degenerate (zero) normal.
+          if (n != t &&
+              (row_of[n] < 0 || chart[n] != chart[t] || normal[n].dot(normal[t]) < min_cos))
+            continue;
           const float w =
               spatial[std::size_t(dy + r) * std::size_t(2 * r + 1) + std::size_t(dx + r)];
           const float* in = original(std::size_t(nx), std::size_t(ny), y);
@@ -95,7 +98,7 @@ void filter_slf_texels(SlfMatrix& m, const meshes::Mesh& mesh, const meshes::Atl
           total += w;
         }
       }
-      const float scale = float(1.0 / total);  // the texel itself always counts
+      const float scale = float(1.0 / total);
       for (std::size_t c = 0; c < columns; ++c) o_row[c] *= scale;
     });
     float* slot = ring.data() + (y % std::size_t(r + 1)) * width * columns;
