@@ -95,13 +95,14 @@ pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probe
                          const std::string& probe_name, pipeline::SlfSettings settings,
                          MpiWorld world) {
   if (!o.rows.empty()) throw UsageError("--rows and mpirun both split the rows: use one of them");
-  std::uint64_t rows = 0;
+  meshes::Atlas atlas;
   try {
-    rows = meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts})
-               .used_texels();
+    atlas =
+        meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());  // an atlas too small for the mesh
   }
+  const std::uint64_t rows = atlas.used_texels();
   const std::uint64_t ranks = std::uint64_t(world.size);
   if (rows < ranks || rows < std::uint64_t(std::max(1, settings.compress.clusters)))
     throw UsageError("mpirun -np " + std::to_string(world.size) + " with --clusters " +
@@ -122,8 +123,6 @@ pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probe
       bake.progress = [&bar](std::uint64_t done, std::uint64_t total) {
         bar.update("slf bake (rank 0's rows)", done, total);
       };
-      const meshes::Atlas atlas =
-          meshes::make_atlas(mesh, settings.atlas_width, settings.atlas_height, {settings.charts});
       prt::bake_slf_to_file(mesh, atlas, probe, bake, part(world.rank));
       bar.finish();
     } catch (const std::exception& e) {
@@ -139,8 +138,8 @@ pipeline::SlfRun mpi_slf(const Options& o, const meshes::Mesh& mesh, const probe
       prt::SlfMatrix matrix = prt::join_slf_parts(parts);
       const double bake_seconds =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      r = pipeline::compress_slf(mesh, o.mesh, probe_name, std::move(matrix), settings.compress,
-                                 settings.filter, stderr_reporter(quiet));
+      r = pipeline::compress_slf(mesh, atlas, o.mesh, probe_name, std::move(matrix),
+                                 settings.compress, settings.filter, stderr_reporter(quiet));
       r.bake_seconds = bake_seconds;
       pipeline::write_slfc(o.output, r.slf);
       for (const fs::path& p : parts) fs::remove(p);

@@ -125,7 +125,7 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
     }
   }
   const double bake_seconds = seconds_since(bake_start);
-  SlfRun compressed = compress_slf(mesh, mesh_path, probe_name, std::move(matrix),
+  SlfRun compressed = compress_slf(mesh, atlas, mesh_path, probe_name, std::move(matrix),
                                    settings.compress, settings.filter, reporter);
   compressed.bake_seconds = bake_seconds;
   compressed.bake_cached = run.bake_cached;
@@ -133,10 +133,10 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
   return compressed;
 }
 
-SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
-                    const std::string& probe_name, prt::SlfMatrix matrix,
-                    cpca::CompressOptions compress, const prt::SlfFilterOptions& filter,
-                    const Reporter& reporter) {
+SlfRun compress_slf(const meshes::Mesh& mesh, const meshes::Atlas& atlas,
+                    const std::string& mesh_path, const std::string& probe_name,
+                    prt::SlfMatrix matrix, cpca::CompressOptions compress,
+                    const prt::SlfFilterOptions& filter, const Reporter& reporter) {
   SlfRun run;
   const std::uint64_t count = matrix.shape.row_count;
   const std::size_t columns = matrix.shape.columns();
@@ -146,11 +146,8 @@ SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
                                 std::to_string(count) + " rows x " + std::to_string(columns));
   filter.validate();
   if (filter.radius > 0 && matrix.shape.first_row == 0 &&
-      matrix.shape.row_count == matrix.shape.rows) {
-    const meshes::Atlas atlas = meshes::make_atlas(
-        mesh, matrix.shape.atlas_width, matrix.shape.atlas_height, {matrix.shape.charts});
+      matrix.shape.row_count == matrix.shape.rows)
     prt::filter_slf_texels(matrix, mesh, atlas, filter);
-  }
   compress.layout = {1, 3, matrix.shape.grid.directions()};
   const Eigen::Map<const cpca::DataMatrix> data(matrix.data.data(), Eigen::Index(count),
                                                 Eigen::Index(columns));

@@ -67,7 +67,6 @@ void filter_slf_texels(SlfMatrix& m, const meshes::Mesh& mesh, const meshes::Atl
   // Originals of the atlas rows y - r .. y - 1, slot y mod (r + 1), by x.
   std::vector<float> ring(std::size_t(r + 1) * width * columns);
   std::vector<float> out(width * columns);
-  std::vector<std::uint8_t> filtered(width);
   const auto original = [&](std::size_t x, std::size_t y, std::size_t now) -> const float* {
     if (y >= now) return m.data.data() + std::size_t(row_of[y * width + x]) * columns;
     return ring.data() + ((y % std::size_t(r + 1)) * width + x) * columns;
@@ -75,8 +74,7 @@ void filter_slf_texels(SlfMatrix& m, const meshes::Mesh& mesh, const meshes::Atl
   for (std::size_t y = 0; y < height; ++y) {
     tbb::parallel_for(std::size_t(0), width, [&](std::size_t x) {
       const std::size_t t = y * width + x;
-      filtered[x] = row_of[t] >= 0;
-      if (!filtered[x]) return;
+      if (row_of[t] < 0) return;
       float* o_row = out.data() + x * columns;
       std::fill(o_row, o_row + columns, 0.f);
       double total = 0;
@@ -103,7 +101,7 @@ void filter_slf_texels(SlfMatrix& m, const meshes::Mesh& mesh, const meshes::Atl
     });
     float* slot = ring.data() + (y % std::size_t(r + 1)) * width * columns;
     for (std::size_t x = 0; x < width; ++x) {
-      if (!filtered[x]) continue;
+      if (row_of[y * width + x] < 0) continue;
       float* row = m.data.data() + std::size_t(row_of[y * width + x]) * columns;
       std::copy_n(row, columns, slot + x * columns);
       std::copy_n(out.data() + x * columns, columns, row);

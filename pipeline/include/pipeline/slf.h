@@ -55,14 +55,14 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
                 const std::string& probe_name, SlfSettings settings,
                 const std::filesystem::path& cache_dir, const Reporter& reporter);
 
-// The compression half of make_slf: the texel filter (a whole matrix only; its atlas made
-// again from the mesh and the matrix's shape), CPCA of the matrix (its shape says which rows)
-// and the figures, for a matrix baked elsewhere (prtr slf under mpirun joins the ranks' parts).
-// The bake fields of the result are left at zero. Throws std::invalid_argument for bad
-// options (more clusters than rows) and a matrix whose data does not match its shape.
-SlfRun compress_slf(const meshes::Mesh& mesh, const std::string& mesh_path,
-                    const std::string& probe_name, prt::SlfMatrix matrix,
-                    cpca::CompressOptions compress, const prt::SlfFilterOptions& filter,
-                    const Reporter& reporter);
+// The compression half of make_slf: the texel filter (a whole matrix only), CPCA of the
+// matrix (its shape says which rows) and the figures, for a matrix baked elsewhere (prtr slf
+// under mpirun joins the ranks' parts). `atlas` is the one the matrix was baked on. The bake
+// fields of the result are left at zero. Throws std::invalid_argument for bad options (more
+// clusters than rows) and a matrix whose data does not match its shape or atlas.
+SlfRun compress_slf(const meshes::Mesh& mesh, const meshes::Atlas& atlas,
+                    const std::string& mesh_path, const std::string& probe_name,
+                    prt::SlfMatrix matrix, cpca::CompressOptions compress,
+                    const prt::SlfFilterOptions& filter, const Reporter& reporter);
 
 }  // namespace pipeline
