@@ -10,6 +10,7 @@
 #include <Eigen/QR>
 
 #include <algorithm>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -65,6 +66,32 @@ TEST(Compress, AffineSubspacesAreRecoveredExactly) {
         EXPECT_EQ(set.cluster_of[p] == set.cluster_of[p - 1], truth[p] == truth[p - 1]);
     }
   }
+}
+
+// Original CPCA's PCA stage on its own LBG clusters, without LBG: the same fit to the bit,
+// and labels that do not fit the data or K are refused.
+TEST(Compress, FitClusteringIsLbgPlusPcaWithoutLbg) {
+  const cpca::DataMatrix x = affine_subspaces(5, 40, 2, 9, 21);
+  cpca::CompressOptions o;
+  o.clusters = 5;
+  o.components = 2;
+  o.layout = {3, 1, 1};
+  const cpca::CompressedSet lbg = cpca::compress(x, o);
+  std::vector<double> error;
+  const cpca::CompressedSet fit = cpca::fit_clustering(x, o, lbg.cluster_of, &error);
+  EXPECT_EQ(fit.cluster_of, lbg.cluster_of);
+  EXPECT_EQ(fit.means, lbg.means);
+  EXPECT_EQ(fit.bases, lbg.bases);
+  EXPECT_EQ(fit.weights, lbg.weights);
+  ASSERT_EQ(error.size(), std::size_t(x.rows()));
+  const double total = std::accumulate(error.begin(), error.end(), 0.0);
+  EXPECT_NEAR(total / double(x.rows()), cpca::error_metrics(x, lbg).average_squared_error,
+              1e-6 * std::max(1.0, total));
+  std::vector<std::uint32_t> short_labels(lbg.cluster_of.begin(), lbg.cluster_of.end() - 1);
+  EXPECT_THROW(cpca::fit_clustering(x, o, short_labels), std::invalid_argument);
+  std::vector<std::uint32_t> out_of_range = lbg.cluster_of;
+  out_of_range[3] = 5;
+  EXPECT_THROW(cpca::fit_clustering(x, o, out_of_range), std::invalid_argument);
 }
 
 TEST(Compress, ClustersEqualToVerticesGiveZeroError) {

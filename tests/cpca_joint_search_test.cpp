@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 
@@ -244,6 +245,41 @@ TEST(EpsilonSearch, HoldsWhenPatchesAreTooSmall) {
               original.error.average_squared_error * (1 + kRefitTolerance));
     EXPECT_EQ(search.triangles_drawn, brute_force_draws(set.cluster_of, g.triangles));
   }
+}
+
+// A cap no step can reach (a tenth of the start's error): the search stops once its excess,
+// falling at its last rate, could not reach zero in the steps left, and leaves a valid state
+// whose draws are still counted right.
+TEST(EpsilonSearch, GivesUpOnACapItCannotReach) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 5);
+  cpca::CompressOptions o = options(cpca::ClusterMethod::kLbg, 0);
+  cpca::CompressedSet set = cpca::compress(x, o);
+  cpca::PowerIterationOptions power;
+  power.seed = o.seed;
+  std::vector<double> error = cpca::fit_cluster_pca(x, set, o.solver, power);
+  const double start = std::accumulate(error.begin(), error.end(), 0.0) / double(x.rows());
+  std::vector<std::uint32_t> pass_of(kClusters);
+  for (std::uint32_t c = 0; c < kClusters; ++c) pass_of[c] = c / kPerPass;
+  cpca::JointSearchOptions jo;
+  jo.per_pass = kPerPass;
+  jo.max_steps = 20;
+  jo.error_target = 0.1 * start;
+  const cpca::JointSearchResult r = cpca::joint_search(x, g, set, error, pass_of, jo);
+  EXPECT_TRUE(r.gave_up);
+  EXPECT_LT(r.tried, jo.max_steps);
+  std::uint64_t drawn = 0;
+  for (const cpca::TriangleIndices& t : g.triangles)
+    drawn +=
+        std::set<std::uint32_t>{r.pass_of[set.cluster_of[t[0]]], r.pass_of[set.cluster_of[t[1]]],
+                                r.pass_of[set.cluster_of[t[2]]]}
+            .size();
+  EXPECT_EQ(r.triangles_drawn, drawn);
+  // A reachable cap (the start's own error) is never given up on.
+  cpca::CompressedSet again = cpca::compress(x, o);
+  std::vector<double> again_error = cpca::fit_cluster_pca(x, again, o.solver, power);
+  jo.error_target = start;
+  EXPECT_FALSE(cpca::joint_search(x, g, again, again_error, pass_of, jo).gave_up);
 }
 
 TEST(EpsilonSearch, DeterministicForASeed) {

@@ -257,6 +257,17 @@ TEST(SuperclusterRefine, FastDeltasMatchReferenceAndRecount) {
       const std::uint32_t q = std::uint32_t(rng() % std::uint32_t(passes));
       ASSERT_EQ(search.delta_move(c, q), search.delta_move_reference(c, q));
       ASSERT_EQ(search.delta_swap(c, d), search.delta_swap_reference(c, d));
+      // The corrections descend() takes from one walk, for all of c's partners at once.
+      std::vector<std::int64_t> correction(std::size_t(k), 0);
+      search.shared_corrections(c, correction);
+      for (std::uint32_t e = 0; e < std::uint32_t(k); ++e) {
+        const std::uint32_t pc = search.pass_of()[c], pe = search.pass_of()[e];
+        if (e == c || pc == pe) continue;
+        ASSERT_EQ(
+            search.delta_move_reference(c, pe) + search.delta_move_reference(e, pc) + correction[e],
+            search.delta_swap_reference(c, e))
+            << "seed " << seed << " step " << step << " partner " << e;
+      }
       const std::uint64_t before = search.drawn();
       if (step % 2 == 0 && int(search.members(q).size()) < per_pass && search.pass_of()[c] != q) {
         const std::int64_t delta = search.delta_move(c, q);

@@ -209,6 +209,28 @@ void measure(const RowBlocks& data, const CompressOptions& options, const Geomet
 
 }  // namespace
 
+CompressedSet fit_clustering(const Eigen::Ref<const DataMatrix>& data,
+                             const CompressOptions& options, std::vector<std::uint32_t> cluster_of,
+                             std::vector<double>* vertex_error) {
+  if (cluster_of.size() != std::size_t(data.rows()))
+    throw std::invalid_argument("fit_clustering: " + std::to_string(cluster_of.size()) +
+                                " cluster labels for " + std::to_string(data.rows()) + " rows");
+  for (std::uint32_t c : cluster_of)
+    if (c >= std::uint32_t(options.clusters))
+      throw std::invalid_argument("fit_clustering: cluster " + std::to_string(c) +
+                                  " is out of range for " + std::to_string(options.clusters) +
+                                  " clusters");
+  CompressOptions lbg = options;
+  lbg.method = ClusterMethod::kLbg;
+  CompressedSet set =
+      new_set(lbg, resolve_layout(options.layout, data.cols()), std::move(cluster_of));
+  PowerIterationOptions power;
+  power.seed = options.seed;
+  std::vector<double> error = fit_cluster_pca(data, set, options.solver, power);
+  if (vertex_error) *vertex_error = std::move(error);
+  return set;
+}
+
 CompressedSet compress(const Eigen::Ref<const DataMatrix>& data, const CompressOptions& options,
                        const Geometry* geometry, CompressReport* report,
                        const CompressProgress& progress) {

@@ -42,6 +42,14 @@ CompressedSet compress(const RowBlocks& data, const CompressOptions& options,
                        const Geometry* geometry = nullptr, CompressReport* report = nullptr,
                        const CompressProgress& progress = {}, Distribution* distribution = nullptr);
 
+// Original CPCA's PCA stage on a clustering already made (cluster_of, one entry per row,
+// each < options.clusters): the clusters, means, bases and weights compress() returns for
+// LBG when its LBG gave these clusters, without running LBG again. `vertex_error`, when given,
+// receives each row's squared error.
+CompressedSet fit_clustering(const Eigen::Ref<const DataMatrix>& data,
+                             const CompressOptions& options, std::vector<std::uint32_t> cluster_of,
+                             std::vector<double>* vertex_error = nullptr);
+
 // Average SE, relative and max error of a set against its data, by reconstructing every row
 // (a code path independent of the compressor's own bookkeeping).
 ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set);

@@ -63,6 +63,9 @@ struct JointSearchResult {
   std::uint64_t vertex_moves = 0, pass_swaps = 0;
   int steps = 0;  // accepted steps
   int tried = 0;  // steps tried (a last one may be undone), as iterative CPCA counts them
+  // The epsilon search stopped above the cap because its excess, falling at its last rate,
+  // would not have reached zero in the steps left.
+  bool gave_up = false;
 };
 
 // Pass sizes that group_in_order(K, per_pass) has: per_pass for all but the last pass. From

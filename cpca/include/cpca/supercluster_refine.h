@@ -37,6 +37,10 @@ class GroupingLocalSearch {
   // versions to them.
   std::int64_t delta_move_reference(std::uint32_t c, std::uint32_t q) const;
   std::int64_t delta_swap_reference(std::uint32_t c, std::uint32_t d) const;
+  // For every neighbour d of c, adds to correction[d] (sized K) the part of delta_swap(c, d)
+  // beyond the two single moves, delta_move(c, pass of d) + delta_move(d, pass of c): one walk
+  // over c's hyperedges for all its partners, which descend() needs, instead of one a partner.
+  void shared_corrections(std::uint32_t c, std::vector<std::int64_t>& correction) const;
   // Apply them (no capacity check beyond an always-on one for moves).
   void move(std::uint32_t c, std::uint32_t q);
   void swap(std::uint32_t c, std::uint32_t d);
