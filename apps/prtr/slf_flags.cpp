@@ -35,7 +35,9 @@ void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
       ->check(CLI::IsMember(meshes::kAtlasChartsNames.names()))
       ->capture_default_str();
   cmd->add_option("--directions", f.directions,
-                  "Surface light field: direction grid ZxW, azimuth x polar cells over the sphere")
+                  "Surface light field: direction grid ZxW, azimuth x polar cells over the "
+                  "sphere (64x32, the SLF paper's glossy grid, sharpens glints at 4x the bake "
+                  "with the same --spp)")
       ->capture_default_str();
   add_checked_option(cmd, "--spp", f.spp,
                      "Surface light field: path-traced samples per texel and direction cell",
