@@ -22,7 +22,9 @@ run() {  # run ARGS...: sets out, err, code
   # Under the sanitizers, LeakSanitizer stops every thread with ptrace at exit and its tracer
   # can itself crash after the command has done its work: a fault of the checker, not a
   # finding. That command (not the whole test, some 30 minutes there) runs once more, said
-  # on stdout; a real report (ASan, a leak, UBSan) is never retried.
+  # on stdout; a real report (ASan, a leak, UBSan) is never retried. The retry meets the
+  # caches the first run wrote, so a check that wants a cold cache can still fail, and
+  # scripts/sanitize.sh then reruns the whole test as before.
   if [[ $code != 0 && $err == *"LeakSanitizer has encountered a fatal error"* &&
         $err != *"ERROR: AddressSanitizer"* && $err != *"ERROR: LeakSanitizer: detected"* &&
         $err != *"runtime error:"* ]]; then
