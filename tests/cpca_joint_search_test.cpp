@@ -297,6 +297,48 @@ TEST(EpsilonSearch, DeterministicForASeed) {
   EXPECT_THROW(cpca::compress(x, o, &g), std::invalid_argument);
 }
 
+// Distances carried from step to step (to clusters no kept step refitted since) against
+// every distance computed afresh: the same search, step for step. Both from a start above the
+// cap (patch-first's clusters, the closures' distances) so both kinds of step are taken.
+TEST(EpsilonSearch, ReusedDistancesEqualFreshOnes) {
+  const cpca::Geometry g = cpca_test::grid(kN);
+  const cpca::DataMatrix x = smooth_data(g, 5);
+  cpca::CompressOptions first = options(cpca::ClusterMethod::kPatchFirst, 0);
+  cpca::CompressedSet start = cpca::compress(x, first, &g);
+  cpca::PowerIterationOptions power;
+  power.seed = first.seed;
+  std::vector<double> start_error = cpca::fit_cluster_pca(x, start, first.solver, power);
+  const double total = std::accumulate(start_error.begin(), start_error.end(), 0.0);
+  std::vector<std::uint32_t> pass_of(kClusters);
+  for (std::uint32_t c = 0; c < kClusters; ++c) pass_of[c] = c / kPerPass;
+  cpca::JointSearchOptions jo;
+  jo.per_pass = kPerPass;
+  jo.candidates = 4;
+  jo.error_target = 0.97 * total / double(x.rows());
+  const auto search = [&](bool reuse, cpca::CompressedSet& set, std::vector<double>& error) {
+    set = start, error = start_error;
+    jo.reuse_distances = reuse;
+    return cpca::joint_search(x, g, set, error, pass_of, jo);
+  };
+  cpca::CompressedSet reused, fresh;
+  std::vector<double> reused_error, fresh_error;
+  const cpca::JointSearchResult a = search(true, reused, reused_error);
+  const cpca::JointSearchResult b = search(false, fresh, fresh_error);
+  ASSERT_GT(a.steps, 2);
+  EXPECT_EQ(a.tried, b.tried);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(a.triangles_drawn, b.triangles_drawn);
+  EXPECT_EQ(a.pass_of, b.pass_of);
+  EXPECT_EQ(reused.cluster_of, fresh.cluster_of);
+  ASSERT_EQ(a.objective.size(), b.objective.size());
+  for (std::size_t i = 0; i < a.objective.size(); ++i)
+    EXPECT_NEAR(a.objective[i], b.objective[i], 1e-9 * b.objective[i]) << "step " << i;
+  // The first step starts above the cap, and a later one is within it.
+  EXPECT_GT(total, jo.error_target * double(x.rows()));
+  EXPECT_LE(std::accumulate(fresh_error.begin(), fresh_error.end(), 0.0),
+            jo.error_target * double(x.rows()) * (1 + kRefitTolerance));
+}
+
 TEST(JointSearch, OrderProfilePutsTheRoomInTheLastPass) {
   const cpca::Geometry g = cpca_test::grid(6);
   std::vector<std::uint32_t> cluster_of(g.positions.size());

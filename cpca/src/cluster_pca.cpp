@@ -106,19 +106,18 @@ std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolv
         set.bases.data() + std::size_t(c) * std::size_t(n) * std::size_t(d), n, d);
     stored = basis.cast<float>();
     const Eigen::MatrixXd b = stored.cast<double>();
-    const Eigen::MatrixXd w = f * b.transpose();  // rows x n
-    // The residual against the stored (float) mean, from the centred rows already in f:
-    // x - mean_f = f + (mean - mean_f), without reading the cluster a second time.
-    const Eigen::RowVectorXd mean_shift = mean - mean.cast<float>().cast<double>();
+    // The weights as stored (float), and the residual against the stored mean and basis, from
+    // the centred rows already in f: x - mean_f = f + (mean - mean_f), without reading the
+    // cluster a second time. One product for all members: row by row it cost more than the
+    // power iteration in a late step's refit.
+    const Eigen::MatrixXd w = (f * b.transpose()).cast<float>().cast<double>();  // rows x n
+    f.noalias() -= w * b;
+    f.rowwise() += mean - mean.cast<float>().cast<double>();
     for (Eigen::Index i = 0; i < rows; ++i) {
       const std::uint32_t p = m[std::size_t(i)];
       for (int j = 0; j < n; ++j)
         set.weights[std::size_t(p) * std::size_t(n) + std::size_t(j)] = float(w(i, j));
-      const Eigen::RowVectorXd wf = Eigen::Map<const Eigen::RowVectorXf>(
-                                        set.weights.data() + std::size_t(p) * std::size_t(n), n)
-                                        .cast<double>();
-      const Eigen::RowVectorXd residual = f.row(i) + mean_shift - wf * b;
-      error[p] = residual.squaredNorm();
+      error[p] = f.row(i).squaredNorm();
     }
   });
   if (stats) stats->power_iterations = iterations;
@@ -349,17 +348,22 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
   return listed_distances(x, set, points);
 }
 
-DataMatrix subspace_distances_near_clusters(const Eigen::Ref<const DataMatrix>& x,
-                                            const CompressedSet& set, int candidates) {
+std::vector<std::vector<std::uint32_t>> cluster_closures(const CompressedSet& set, int candidates) {
   const int k = set.cluster_count;
-  const Eigen::Map<const DataMatrix> means(set.means.data(), k, x.cols());
+  const Eigen::Map<const DataMatrix> means(set.means.data(), k, Eigen::Index(set.dimension()));
   const DataMatrix between = squared_distances(means, means.rowwise().squaredNorm(), means);
-  // Each cluster's closure: itself and its nearest clusters by mean distance.
   std::vector<std::vector<std::uint32_t>> closure(static_cast<std::size_t>(k));
   tbb::parallel_for(0, k, [&](int c) {
     closure[std::size_t(c)] = nearest_ids(k, std::clamp(candidates, 1, k), std::uint32_t(c),
                                           [&](std::uint32_t b) { return between(c, b); });
   });
+  return closure;
+}
+
+DataMatrix subspace_distances_near_clusters(const Eigen::Ref<const DataMatrix>& x,
+                                            const CompressedSet& set, int candidates) {
+  const int k = set.cluster_count;
+  const std::vector<std::vector<std::uint32_t>> closure = cluster_closures(set, candidates);
   std::vector<std::vector<std::uint32_t>> points(static_cast<std::size_t>(k));
   for (std::uint32_t p = 0; p < set.cluster_of.size(); ++p)
     for (std::uint32_t c : closure[set.cluster_of[p]]) points[c].push_back(p);

@@ -299,22 +299,48 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
 
 // The epsilon search's candidates: for every vertex its own cluster (first), the other
 // clusters of its pass (a move among them costs no draws), the clusters of its 1-ring (the
-// only moves that can change draws) and, when `near` is given, the finite entries of its row
-// (its cluster's closure), each with its squared distance to that cluster's affine subspace under
-// the step's bases. Without `near` a step costs O(V (per_pass + ring)) distances instead of
+// only moves that can change draws) and, when `closures` are given, its cluster's closure
+// (cluster_pca.h), each with its squared distance to that cluster's affine subspace under the
+// step's bases. Without closures a step costs O(V (per_pass + ring)) distances instead of
 // iterative CPCA's V x K mean products.
 struct Candidates {
   std::vector<std::uint32_t> offset, cluster;
   std::vector<double> error;
+  // The fit each distance was taken under (FitGenerations), so the next step can reuse it.
+  std::vector<std::uint32_t> generation;
+};
+
+// How many times each cluster's mean and basis have changed in a search. A step refits only
+// the clusters whose members changed (refit_changed), so a vertex's distance to any other
+// cluster is the one an earlier step computed: late steps on the horse (K = 128) refit 25-80
+// clusters and leave 40-70% of the candidate distances known.
+struct FitGenerations {
+  std::vector<std::uint32_t> of;  // per cluster
+  // After a kept step from `before` to `after`.
+  void advance(const CompressedSet& before, const CompressedSet& after) {
+    std::vector<char> changed(of.size(), 0);
+    for (std::size_t p = 0; p < after.cluster_of.size(); ++p)
+      if (after.cluster_of[p] != before.cluster_of[p])
+        changed[before.cluster_of[p]] = changed[after.cluster_of[p]] = 1;
+    for (std::size_t c = 0; c < of.size(); ++c) of[c] += std::uint32_t(changed[c]);
+  }
 };
 
 Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set,
                               const Geometry& g, const VertexTriangles& vt,
-                              const std::vector<std::uint32_t>& pass_of, const DataMatrix* near) {
+                              const std::vector<std::uint32_t>& pass_of,
+                              const std::vector<std::vector<std::uint32_t>>* closures,
+                              const FitGenerations& fits, const Candidates& previous) {
   const std::size_t vertices = set.cluster_of.size();
   std::vector<std::vector<std::uint32_t>> in_pass(
       std::size_t(*std::max_element(pass_of.begin(), pass_of.end())) + 1);
   for (std::uint32_t c = 0; c < pass_of.size(); ++c) in_pass[pass_of[c]].push_back(c);
+  // The closure in id order, as the candidates' order breaks the sweep's ties.
+  std::vector<std::vector<std::uint32_t>> closure_ids;
+  if (closures) {
+    closure_ids = *closures;
+    for (auto& ids : closure_ids) std::sort(ids.begin(), ids.end());
+  }
   const auto list = [&](std::uint32_t p, std::vector<std::uint32_t>& out) {
     const std::uint32_t a = set.cluster_of[p];
     out.assign(1, a);
@@ -325,11 +351,9 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
         const std::uint32_t c = set.cluster_of[v];
         if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
       }
-    if (!near) return;
-    const auto row = near->row(Eigen::Index(p));
-    for (Eigen::Index c = 0; c < row.size(); ++c)
-      if (std::isfinite(row[c]) && std::find(out.begin(), out.end(), std::uint32_t(c)) == out.end())
-        out.push_back(std::uint32_t(c));
+    if (!closures) return;
+    for (std::uint32_t c : closure_ids[a])
+      if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
   };
   std::vector<std::vector<std::uint32_t>> lists(vertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, 512), [&](const auto& range) {
@@ -341,22 +365,26 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
     r.offset[p + 1] = r.offset[p] + std::uint32_t(lists[p].size());
   r.cluster.resize(r.offset.back());
   r.error.resize(r.offset.back());
-  // Each cluster's candidate points in one matrix product (as subspace_distances does): one
-  // (point, cluster) pair at a time cost half the search's time.
-  // The closure's distances are already in `near`, computed the same way.
+  r.generation.resize(r.offset.back());
+  // The distances not known from the previous step, each cluster's candidate points in one
+  // matrix product (as subspace_distances does): one (point, cluster) pair at a time cost half
+  // the search's time.
+  const bool has_previous = previous.offset.size() == vertices + 1;
   std::vector<std::vector<std::uint32_t>> entries(std::size_t(set.cluster_count));
   std::vector<std::uint32_t> point_of(r.offset.back());
   for (std::uint32_t p = 0; p < vertices; ++p)
     for (std::uint32_t i = 0; i < lists[p].size(); ++i) {
       const std::uint32_t c = lists[p][i], e = r.offset[p] + i;
       r.cluster[e] = c;
+      r.generation[e] = fits.of[c];
       point_of[e] = p;
-      if (const float known = near ? (*near)(Eigen::Index(p), Eigen::Index(c))
-                                   : std::numeric_limits<float>::infinity();
-          std::isfinite(known))
-        r.error[e] = double(known);
-      else
-        entries[c].push_back(e);
+      bool known = false;
+      for (std::uint32_t j = has_previous ? previous.offset[p] : 0,
+                         end = has_previous ? previous.offset[p + 1] : 0;
+           j < end && !known; ++j)
+        if (previous.cluster[j] == c && previous.generation[j] == fits.of[c])
+          r.error[e] = previous.error[j], known = true;
+      if (!known) entries[c].push_back(e);
     }
   tbb::parallel_for(0, set.cluster_count, [&](int c) {
     const std::vector<std::uint32_t>& e = entries[std::size_t(c)];
@@ -562,15 +590,17 @@ std::int64_t cut_borders(const Candidates& cand, SweepState& s, double cap, doub
 bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
                   const VertexTriangles& vt, const JointSearchOptions& o, double mu,
                   double cap_total, CompressedSet& set, std::vector<double>& error,
-                  std::vector<std::uint32_t>& pass_of, ClusterGrams& grams, JointSearchResult& r,
-                  bool& feasible, bool& overpriced) {
+                  std::vector<std::uint32_t>& pass_of, ClusterGrams& grams, Candidates& memo,
+                  FitGenerations& fits, JointSearchResult& r, bool& feasible, bool& overpriced) {
   // Above the cap the search needs error-lowering moves, which the clusters near a vertex's
   // own offer (its cluster's closure, cluster_pca.h); within it only moves that change draws
   // matter, and those are bounded to the 1-ring, so no such distances are computed.
   const bool above = total_of(error) > cap_total;
-  const DataMatrix near =
-      above ? subspace_distances_near_clusters(data, set, o.candidates) : DataMatrix();
-  const Candidates cand = bounded_candidates(data, set, g, vt, pass_of, above ? &near : nullptr);
+  const std::vector<std::vector<std::uint32_t>> closures =
+      above ? cluster_closures(set, o.candidates) : std::vector<std::vector<std::uint32_t>>();
+  if (!o.reuse_distances) memo = Candidates();
+  memo = bounded_candidates(data, set, g, vt, pass_of, above ? &closures : nullptr, fits, memo);
+  const Candidates& cand = memo;
   CompressedSet next = set;
   std::vector<std::uint32_t> next_pass = pass_of;
   std::uint64_t moves = 0, swaps = 0;
@@ -598,6 +628,7 @@ bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
                           : feasible && (drawn < r.triangles_drawn || (drawn == r.triangles_drawn &&
                                                                        after_error < before_error));
   if (!better) return false;
+  fits.advance(set, next);
   keep_step(std::move(next), std::move(next_error), std::move(next_pass), drawn, moves, swaps,
             after_error / double(data.rows()), set, error, pass_of, r);
   return true;
@@ -723,13 +754,16 @@ JointSearchResult joint_search(const Eigen::Ref<const DataMatrix>& data, const G
     double price = 2 * total / t;
     r.triangles_drawn = swap_descent(inc, options.per_pass, pass_of, r.pass_swaps);
     ClusterGrams grams;
+    Candidates memo;
+    FitGenerations fits{std::vector<std::uint32_t>(std::size_t(set.cluster_count), 0)};
     for (int i = 1, rejected = 0; i <= options.max_steps && rejected < 3; ++i) {
       r.tried = i;
       bool feasible = false, overpriced = false;
       const double error_before = total_of(vertex_error);
       const std::uint64_t drawn_before = r.triangles_drawn;
-      const bool kept = epsilon_step(data, geometry, vt, options, price, cap_total, set,
-                                     vertex_error, pass_of, grams, r, feasible, overpriced);
+      const bool kept =
+          epsilon_step(data, geometry, vt, options, price, cap_total, set, vertex_error, pass_of,
+                       grams, memo, fits, r, feasible, overpriced);
       // A kept step that moved neither the extra draws (those above one a triangle, what the
       // search can change) nor, from above the cap, the error by the threshold counts as a
       // stall. Within the cap the objective is the draws alone: a falling error only widens an

@@ -77,6 +77,12 @@ DataMatrix subspace_distances(const Eigen::Ref<const DataMatrix>& x,
 DataMatrix subspace_distances_near_clusters(const Eigen::Ref<const DataMatrix>& x,
                                             const CompressedSet& set, int candidates);
 
+// Each cluster's closure as used above: itself and the `candidates` clusters whose means are
+// nearest its mean, nearest first (ties to the lower id), the cluster itself appended when
+// tied out. For callers that keep distances of their own (the epsilon search's, from step to
+// step).
+std::vector<std::vector<std::uint32_t>> cluster_closures(const CompressedSet& set, int candidates);
+
 // The same for rows `points` of x and one cluster, in float, clamped at 0: result[i] is
 // points[i]'s distance.
 std::vector<float> subspace_residuals(const Eigen::Ref<const DataMatrix>& x,

@@ -53,6 +53,10 @@ struct JointSearchOptions {
   // row that move neither the extra draws nor the error by `threshold`.
   double error_target = 0.0;
   double refit_tolerance = 1e-6;  // the bases are stored as floats
+  // A candidate's distance to a cluster whose fit no kept step has changed since is taken
+  // from the step that computed it; false computes every distance in every step (the
+  // reference the tests hold the reuse to).
+  bool reuse_distances = true;
 };
 
 struct JointSearchResult {
