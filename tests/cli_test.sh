@@ -10,40 +10,8 @@ prtr=$1
 tmp=$2
 json_check=$3
 plot_script=$4
-rm -rf "$tmp" && mkdir -p "$tmp"
-passed=0
-failed=0
-
-check() {  # check NAME CONDITION-RESULT
-  if [[ $2 == 0 ]]; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAIL: $1"; fi
-}
-run() {  # run ARGS...: sets out, err, code
-  out=$("$prtr" "$@" 2>"$tmp/err"); code=$?; err=$(cat "$tmp/err")
-  # Under the sanitizers, LeakSanitizer stops every thread with ptrace at exit and its tracer
-  # can itself crash after the command has done its work: a fault of the checker, not a
-  # finding. That command (not the whole test, some 30 minutes there) runs once more, said
-  # on stdout; a real report (ASan, a leak, UBSan) is never retried. The retry meets the
-  # caches the first run wrote, so a check that wants a cold cache can still fail, and
-  # scripts/sanitize.sh then reruns the whole test as before.
-  if [[ $code != 0 && $err == *"LeakSanitizer has encountered a fatal error"* &&
-        $err != *"ERROR: AddressSanitizer"* && $err != *"ERROR: LeakSanitizer: detected"* &&
-        $err != *"runtime error:"* ]]; then
-    echo "RETRY: LeakSanitizer's tracer crashed after prtr $*; running it once more"
-    out=$("$prtr" "$@" 2>"$tmp/err"); code=$?; err=$(cat "$tmp/err")
-  fi
-}
-expect_code() { [[ $code == "$1" ]]; }
-skip() { echo "SKIP: $1"; }
-# jget FILE|- POINTER: the value at a JSON pointer (strings unquoted); fails on invalid JSON.
-jget() { "$json_check" "$@"; }
-# media_info FILE: "width,height,frames" of the first video stream, decoded by ffprobe.
-media_info() {
-  ffprobe -v error -count_frames -select_streams v:0 \
-    -show_entries stream=width,height,nb_read_frames -of csv=p=0 "$1" 2>/dev/null
-}
-# rmse A.exr B.exr: prtr compare's relative RMSE of two images (0.0 when they are equal).
-rmse() { "$prtr" compare "$1" "$2" --json | jget - /relative_rmse; }
-have_matplotlib() { /usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1; }
+# The numeric flag sweep is its own test (cli_flags_test.sh), so that the two run side by side.
+source "$(dirname "$0")/cli_lib.sh"
 
 # Usage.
 run --help; expect_code 0; check "--help exits 0" $?
@@ -53,33 +21,6 @@ run probe x.exr --order 11; expect_code 2; check "order 11 is a usage error" $?
 run probe x.exr --order 0; expect_code 2; check "order 0 is a usage error" $?
 run mesh a.obj --bogus; expect_code 2; check "unknown flag exits 2" $?
 
-# Every numeric flag of every command, read off --help: an empty value, a negative or
-# unparsable one and one past any range are usage errors that name the flag, and no message
-# holds a number longer than 15 digits (CLI11's own ranges printed DBL_MAX in full). Each flag
-# gets every value: the empty one (which CLI11 alone would read as 0) and the other four. A
-# process start is a few milliseconds (image libraries load only when an image is touched,
-# common/image_codec.h). PRTR_CLI_SWEEP=0 skips the sweep.
-numeric_flags=0
-others=("-1" "abc" "1e400" "99999999999999999999999")
-subcommands=(bake compress merge mesh probe info render relight overdraw view gl-info slf path-trace compare)
-[[ ${PRTR_CLI_SWEEP:-1} == 0 ]] && { subcommands=(); skip "numeric flag sweep (PRTR_CLI_SWEEP=0)"; }
-for sub in "${subcommands[@]}"; do
-  while read -r flag; do
-    numeric_flags=$((numeric_flags + 1))
-    for bad in "" "${others[@]}"; do
-      run "$sub" "$flag" "$bad"
-      # "-1" is a valid value of flags whose range holds it (angles, exposure, weld
-      # tolerance): the flag is then accepted and only the missing arguments are reported.
-      [[ $bad == -1 && $err != *"$flag"* ]] && continue
-      shown=${err//"'$bad'"/}  # the value itself, echoed back, may be long
-      if ! { expect_code 2 && [[ $err == *"$flag"* ]] && ! [[ $shown =~ [0-9]{16} ]]; }; then
-        echo "  $sub $flag '$bad': exit $code: $err"; false
-      fi
-      check "$sub $flag '$bad' is a usage error naming the flag" $?
-    done
-  done < <("$prtr" "$sub" --help 2>/dev/null | grep -oE '^ +(-[a-z], ?)?--[a-z0-9-]+ (INT|UINT|FLOAT)' | grep -oE -- '--[a-z0-9-]+')
-done
-((numeric_flags > 40 || ${#subcommands[@]} == 0)); check "numeric flags found in --help: $numeric_flags" $?
 
 # Image I/O lives in a module loaded on first use: prtr itself links no OpenImageIO, commands
 # that touch no image run without the module, and one that needs it says what is missing.
@@ -619,5 +560,4 @@ if [[ -f $forest ]]; then
   expect_code 1 && [[ $err == *"inside the outline"* ]]; check "compare --erode wider than the mesh fails saying so" $?
 fi
 
-echo "cli: $passed passed, $failed failed"
-((failed == 0))
+finish cli
