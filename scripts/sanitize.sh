@@ -69,8 +69,8 @@ status=0
 # a fault of the checker, not a finding, seen once in some twenty runs of the suite, in a GL
 # test whose repeats all pass, and since in the CLI test, after `prtr overdraw` (cli.end_to_end
 # takes 15 minutes under the sanitizers on the 2-core machine, so rerunning it adds most of
-# the suite again). That test retries the one command instead (tests/cli_lib.sh, run); here, only
-# when no sanitizer reported anything, the failed tests run once more, and the retry is
+# the suite again). That test retries the one command instead (tests/cli_lib.sh, run); here,
+# only when no sanitizer reported anything, the failed tests run once more, and the retry is
 # announced.
 log=$dir/Testing/Temporary/LastTest.log
 if ((status != 0)) && [[ -f $log ]] &&

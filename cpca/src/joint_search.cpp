@@ -299,7 +299,7 @@ bool step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g, const Ver
 
 // The epsilon search's candidates: for every vertex its own cluster (first), the other
 // clusters of its pass (a move among them costs no draws), the clusters of its 1-ring (the
-// only moves that can change draws) and, when `closures` are given, its cluster's closure
+// only moves that can change draws) and, when `closures` is not empty, its cluster's closure
 // (cluster_pca.h), each with its squared distance to that cluster's affine subspace under the
 // step's bases. Without closures a step costs O(V (per_pass + ring)) distances instead of
 // iterative CPCA's V x K mean products.
@@ -329,18 +329,14 @@ struct FitGenerations {
 Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const CompressedSet& set,
                               const Geometry& g, const VertexTriangles& vt,
                               const std::vector<std::uint32_t>& pass_of,
-                              const std::vector<std::vector<std::uint32_t>>* closures,
+                              std::vector<std::vector<std::uint32_t>> closures,
                               const FitGenerations& fits, const Candidates& previous) {
   const std::size_t vertices = set.cluster_of.size();
   std::vector<std::vector<std::uint32_t>> in_pass(
       std::size_t(*std::max_element(pass_of.begin(), pass_of.end())) + 1);
   for (std::uint32_t c = 0; c < pass_of.size(); ++c) in_pass[pass_of[c]].push_back(c);
   // The closure in id order, as the candidates' order breaks the sweep's ties.
-  std::vector<std::vector<std::uint32_t>> closure_ids;
-  if (closures) {
-    closure_ids = *closures;
-    for (auto& ids : closure_ids) std::sort(ids.begin(), ids.end());
-  }
+  for (auto& ids : closures) std::sort(ids.begin(), ids.end());
   const auto list = [&](std::uint32_t p, std::vector<std::uint32_t>& out) {
     const std::uint32_t a = set.cluster_of[p];
     out.assign(1, a);
@@ -351,8 +347,8 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
         const std::uint32_t c = set.cluster_of[v];
         if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
       }
-    if (!closures) return;
-    for (std::uint32_t c : closure_ids[a])
+    if (closures.empty()) return;
+    for (std::uint32_t c : closures[a])
       if (std::find(out.begin(), out.end(), c) == out.end()) out.push_back(c);
   };
   std::vector<std::vector<std::uint32_t>> lists(vertices);
@@ -366,10 +362,17 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
   r.cluster.resize(r.offset.back());
   r.error.resize(r.offset.back());
   r.generation.resize(r.offset.back());
+  // p's distance to c from the previous step, when c's fit has not changed since.
+  const auto reuse = [&](std::uint32_t p, std::uint32_t c, double& error) {
+    if (previous.offset.size() != vertices + 1) return false;
+    for (std::uint32_t j = previous.offset[p]; j < previous.offset[p + 1]; ++j)
+      if (previous.cluster[j] == c && previous.generation[j] == fits.of[c])
+        return error = previous.error[j], true;
+    return false;
+  };
   // The distances not known from the previous step, each cluster's candidate points in one
   // matrix product (as subspace_distances does): one (point, cluster) pair at a time cost half
   // the search's time.
-  const bool has_previous = previous.offset.size() == vertices + 1;
   std::vector<std::vector<std::uint32_t>> entries(std::size_t(set.cluster_count));
   std::vector<std::uint32_t> point_of(r.offset.back());
   for (std::uint32_t p = 0; p < vertices; ++p)
@@ -378,13 +381,7 @@ Candidates bounded_candidates(const Eigen::Ref<const DataMatrix>& data, const Co
       r.cluster[e] = c;
       r.generation[e] = fits.of[c];
       point_of[e] = p;
-      bool known = false;
-      for (std::uint32_t j = has_previous ? previous.offset[p] : 0,
-                         end = has_previous ? previous.offset[p + 1] : 0;
-           j < end && !known; ++j)
-        if (previous.cluster[j] == c && previous.generation[j] == fits.of[c])
-          r.error[e] = previous.error[j], known = true;
-      if (!known) entries[c].push_back(e);
+      if (!reuse(p, c, r.error[e])) entries[c].push_back(e);
     }
   tbb::parallel_for(0, set.cluster_count, [&](int c) {
     const std::vector<std::uint32_t>& e = entries[std::size_t(c)];
@@ -596,10 +593,11 @@ bool epsilon_step(const Eigen::Ref<const DataMatrix>& data, const Geometry& g,
   // own offer (its cluster's closure, cluster_pca.h); within it only moves that change draws
   // matter, and those are bounded to the 1-ring, so no such distances are computed.
   const bool above = total_of(error) > cap_total;
-  const std::vector<std::vector<std::uint32_t>> closures =
-      above ? cluster_closures(set, o.candidates) : std::vector<std::vector<std::uint32_t>>();
   if (!o.reuse_distances) memo = Candidates();
-  memo = bounded_candidates(data, set, g, vt, pass_of, above ? &closures : nullptr, fits, memo);
+  memo = bounded_candidates(
+      data, set, g, vt, pass_of,
+      above ? cluster_closures(set, o.candidates) : std::vector<std::vector<std::uint32_t>>(), fits,
+      memo);
   const Candidates& cand = memo;
   CompressedSet next = set;
   std::vector<std::uint32_t> next_pass = pass_of;
