@@ -69,9 +69,11 @@ status=0
 # a fault of the checker, not a finding, seen once in some twenty runs of the suite, in a GL
 # test whose repeats all pass, and since in the CLI test, after `prtr overdraw` (cli.end_to_end
 # takes 15 minutes under the sanitizers on the 2-core machine, so rerunning it adds most of
-# the suite again). That test retries the one command instead (tests/cli_lib.sh, run); here,
-# only when no sanitizer reported anything, the failed tests run once more, and the retry is
-# announced.
+# the suite again). That test retries the one command instead (tests/cli_lib.sh, run). A
+# `prtr view` server in view.browser once exited on SIGABRT after SIGTERM with every check
+# passed, most likely the same crash (abort_on_error), but its stderr was not in the log; the
+# view tests now print it when the server exits non-zero. Here, only when no sanitizer
+# reported anything, the failed tests run once more, and the retry is announced.
 log=$dir/Testing/Temporary/LastTest.log
 if ((status != 0)) && [[ -f $log ]] &&
    grep -q "LeakSanitizer has encountered a fatal error" "$log" &&

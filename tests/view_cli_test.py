@@ -254,7 +254,7 @@ def main():
         stop_start = time.monotonic()
         code = server.stop()
         stop_seconds = time.monotonic() - stop_start
-    check("SIGTERM exits 0", code == 0, "(exit %s; stderr %s)" % (code, server.proc.stderr.read()))
+    check("SIGTERM exits 0", code == 0, "(exit %s)" % code)
     # The slow clients are still connected: their sockets are shut down after a 0.5 s grace
     # period (without that, SIGTERM waited 30 s for them; the bound leaves room for the
     # sanitizer build's exit-time leak check).

@@ -134,11 +134,16 @@ class ViewServer:
         if self.proc.poll() is None:
             self.proc.send_signal(sig)
         try:
-            return self.proc.wait(timeout)
+            code = self.proc.wait(timeout)
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
-            return None
+            code = None
+        if code != 0:
+            # A sanitizer's report or an exception's message is the only trace of why.
+            tail = self.proc.stderr.read()[-6000:]
+            print("prtr view exited %s; the end of its stderr:\n%s" % (code, tail))
+        return code
 
     def rss_kib(self):
         with open("/proc/%d/status" % self.proc.pid) as f:
