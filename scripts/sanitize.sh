@@ -72,9 +72,9 @@ status=0
 # LeakSanitizer stops every thread with ptrace at exit, and its tracer can itself crash ("Tracer
 # caught signal 11 ... LeakSanitizer has encountered a fatal error") after a test has passed:
 # a fault of the checker, not a finding, seen once in some twenty runs of the suite, in a GL
-# test whose repeats all pass, and since in the CLI test, after `prtr overdraw` (cli.end_to_end
-# takes 15 minutes under the sanitizers on the 2-core machine, so rerunning it adds most of
-# the suite again). That test retries the one command instead (tests/cli_lib.sh, run). A
+# test whose repeats all pass, and since in the CLI tests, after `prtr overdraw` (the CLI tests
+# take 5-13 minutes each under the sanitizers on the 2-core machine, so rerunning one adds
+# much of the suite again). They retry the one command instead (tests/cli_lib.sh, run). A
 # `prtr view` server in view.browser once exited on SIGABRT after SIGTERM with every check
 # passed, most likely the same crash (abort_on_error), but its stderr was not in the log; the
 # view tests now print it when the server exits non-zero. Here, only when no sanitizer

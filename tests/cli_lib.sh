@@ -35,6 +35,25 @@ media_info() {
 # rmse A.exr B.exr: prtr compare's relative RMSE of two images (0.0 when they are equal).
 rmse() { "$prtr" compare "$1" "$2" --json | jget - /relative_rmse; }
 have_matplotlib() { /usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1; }
+# write_cube FILE: a closed 8-vertex cube as OBJ, quads (any mesh would do for a bake).
+write_cube() {
+  cat >"$1" <<'OBJ'
+v -1 -1 -1
+v 1 -1 -1
+v 1 1 -1
+v -1 1 -1
+v -1 -1 1
+v 1 -1 1
+v 1 1 1
+v -1 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+OBJ
+}
 # finish NAME: the summary; the test's status is whether every check passed.
 finish() {
   echo "$1: $passed passed, $failed failed"
