@@ -105,6 +105,7 @@ fi
 run overdraw "$tmp/cube.obj" --probe "$forest" --rows bogus; expect_code 2 && [[ $err == *--rows* ]]; check "overdraw: unknown row is a usage error" $?
 run overdraw "$tmp/cube.obj" --probe "$forest" --strategies best; expect_code 2 && [[ $err == *--strategies* ]]; check "overdraw: unknown strategy is a usage error" $?
 run overdraw "$tmp/cube.obj" --probe "$forest" --clusters 0; expect_code 2; check "overdraw: --clusters 0 is a usage error" $?
-run overdraw "$tmp/cube.obj" --probe "$forest" --transfer "$tmp/cube.prtx" --order 3; expect_code 2 && [[ $err == *--order* ]]; check "overdraw: bake flag with --transfer is a usage error" $?
+# The transfer file is never read: the conflicting flags are refused first.
+run overdraw "$tmp/cube.obj" --probe "$forest" --transfer "$tmp/absent.prtx" --order 3; expect_code 2 && [[ $err == *--order* ]]; check "overdraw: bake flag with --transfer is a usage error" $?
 
 finish cli.overdraw
