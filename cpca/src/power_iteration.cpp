@@ -26,6 +26,20 @@ void check_k(const Eigen::Ref<const Eigen::MatrixXd>& f, int k) {
 
 using detail::next_uniform;
 
+// Column p of `directions` made orthogonal to columns 0..p-1 (orthonormal already), twice for
+// stability, and normalised; false when less than 1e-6 x `expected` of its norm is left. The
+// directions are columns, not the basis's rows, so each dot product reads contiguous memory:
+// on the basis's strided rows these loops were a third of a small cluster's refit.
+bool orthonormalise(Eigen::MatrixXd& directions, int p, double expected) {
+  auto direction = directions.col(p);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int q = 0; q < p; ++q) direction -= direction.dot(directions.col(q)) * directions.col(q);
+  const double norm = direction.norm();
+  if (!(norm > 1e-6 * expected)) return false;
+  direction /= norm;
+  return true;
+}
+
 // Power iteration with deflation on A (lower triangle read and deflated), the smaller of F^T F
 // and F F^T.
 PcaResult iterate(const Eigen::Ref<const Eigen::MatrixXd>& f, Eigen::MatrixXd& a, int k,
@@ -39,6 +53,8 @@ PcaResult iterate(const Eigen::Ref<const Eigen::MatrixXd>& f, Eigen::MatrixXd& a
   if (!(scale > 0.0)) return result;  // all points equal the mean: nothing to find
   std::uint64_t state = options.seed;
   Eigen::VectorXd v(a.rows()), next(a.rows());
+  Eigen::MatrixXd directions(n, k);
+  int found = 0;
   for (int p = 0; p < k; ++p) {
     for (Eigen::Index i = 0; i < v.size(); ++i) v[i] = next_uniform(state) - 0.5;
     v.normalize();
@@ -67,23 +83,23 @@ PcaResult iterate(const Eigen::Ref<const Eigen::MatrixXd>& f, Eigen::MatrixXd& a
     if (lambda == 0.0) break;  // rows p..k-1 stay zero
     result.eigenvalues[p] = lambda;
     a.selfadjointView<Eigen::Lower>().rankUpdate(v, -lambda);
-    Eigen::RowVectorXd direction = result.gram ? Eigen::RowVectorXd((f.transpose() * v).transpose())
-                                               : Eigen::RowVectorXd(v.transpose());
     // v is a left singular vector u on the Gram path; the principal direction is F^T u /
-    // sigma. Orthogonalising against the earlier rows (twice, for stability) and
+    // sigma. Orthogonalising against the earlier directions (twice, for stability) and
     // renormalising keeps the basis orthonormal even for eigenvalues near the noise floor,
     // where dividing by sigma would amplify rounding.
-    for (int pass = 0; pass < 2; ++pass)
-      for (int q = 0; q < p; ++q)
-        direction -= direction.dot(result.basis.row(q)) * result.basis.row(q);
-    const double norm = direction.norm();
+    auto direction = directions.col(p);
+    if (result.gram)
+      direction.noalias() = f.transpose() * v;
+    else
+      direction = v;
     const double expected = result.gram ? std::sqrt(lambda) : 1.0;
-    if (!(norm > 1e-6 * expected)) {  // nothing left but rounding noise
+    if (!orthonormalise(directions, p, expected)) {  // nothing left but rounding noise
       result.eigenvalues[p] = 0.0;
       break;
     }
-    result.basis.row(p) = direction / norm;
+    found = p + 1;
   }
+  result.basis.topRows(found) = directions.leftCols(found).transpose();
   return result;
 }
 
@@ -151,19 +167,16 @@ PcaResult power_iteration_pca_gram(const Eigen::Ref<const Eigen::MatrixXd>& f, E
   h = 0.5 * (h + h.transpose()).eval();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> ritz(h);
   if (ritz.info() != Eigen::Success) return iterate(f, gram, k, options);
+  // Every direction F^T u in one product, by decreasing eigenvalue.
+  Eigen::MatrixXd directions = f.transpose() * (q * ritz.eigenvectors().rowwise().reverse());
+  int found = 0;
   for (int p = 0; p < k; ++p) {
     const double lambda = ritz.eigenvalues()[k - 1 - p];
-    if (!(lambda > 1e-12 * scale)) break;
-    const Eigen::VectorXd u = q * ritz.eigenvectors().col(k - 1 - p);
-    Eigen::RowVectorXd direction = (f.transpose() * u).transpose();
-    for (int pass = 0; pass < 2; ++pass)
-      for (int r = 0; r < p; ++r)
-        direction -= direction.dot(result.basis.row(r)) * result.basis.row(r);
-    const double norm = direction.norm();
-    if (!(norm > 1e-6 * std::sqrt(lambda))) break;
+    if (!(lambda > 1e-12 * scale) || !orthonormalise(directions, p, std::sqrt(lambda))) break;
     result.eigenvalues[p] = lambda;
-    result.basis.row(p) = direction / norm;
+    found = p + 1;
   }
+  result.basis.topRows(found) = directions.leftCols(found).transpose();
   return result;
 }
 
