@@ -46,8 +46,12 @@ SuperClusters group_search(const ClusterIncidence& inc, int per_pass,
   GroupingLocalSearch best_found = current;
   const long iterations = long(options.kicks_per_cluster) * k_count;
   std::vector<std::uint32_t> touched;
+  // One trial state for the whole search, assigned from `current` each iteration and swapped
+  // with it on acceptance: a copy assignment reuses the buffers (the K x passes pull table and
+  // a member list per pass), where a fresh copy allocated them all again, K x 20 times.
+  GroupingLocalSearch trial = current;
   for (long it = 0; it < iterations; ++it) {
-    GroupingLocalSearch trial = current;
+    trial = current;
     touched.clear();
     const int kicks = 1 + int(rng() % 3);
     for (int kick = 0; kick < kicks; ++kick) {
@@ -72,7 +76,7 @@ SuperClusters group_search(const ClusterIncidence& inc, int per_pass,
     if (touched.empty()) continue;
     trial.descend(touched);
     if (trial.drawn() <= current.drawn()) {
-      current = std::move(trial);
+      std::swap(current, trial);
       if (current.drawn() < best_found.drawn()) best_found = current;
     }
   }
