@@ -101,11 +101,8 @@ ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data, const Compr
   validate(set);
   if (set.vertex_count != std::uint64_t(data.rows()) || set.dimension() != std::size_t(data.cols()))
     throw std::invalid_argument("error_metrics: the set does not match the data's shape");
-  DataMatrix reconstruction(data.rows(), data.cols());
-  tbb::parallel_for(Eigen::Index(0), data.rows(), [&](Eigen::Index p) {
-    reconstruct_vertex(set, std::uint64_t(p), reconstruction.row(p).data());
-  });
-  return error_metrics(data, reconstruction);
+  return error_metrics_by_row(
+      data, [&](Eigen::Index p, float* out) { reconstruct_vertex(set, std::uint64_t(p), out); });
 }
 
 namespace {

@@ -9,14 +9,11 @@
 
 namespace cpca {
 
-ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data,
-                           const Eigen::Ref<const DataMatrix>& reconstruction) {
-  if (data.rows() != reconstruction.rows() || data.cols() != reconstruction.cols()) {
-    throw std::invalid_argument("error_metrics: data is " + std::to_string(data.rows()) + "x" +
-                                std::to_string(data.cols()) + " but reconstruction is " +
-                                std::to_string(reconstruction.rows()) + "x" +
-                                std::to_string(reconstruction.cols()));
-  }
+namespace {
+
+// row(r, buffer) returns row r of the reconstruction (a view, or `buffer` filled).
+template <class Row>
+ErrorMetrics accumulate(const Eigen::Ref<const DataMatrix>& data, Row&& row) {
   const Eigen::Index rows = data.rows();
   if (rows == 0) return {};
   // Fixed block size so the reduction order does not depend on the thread count.
@@ -28,11 +25,12 @@ ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data,
   std::vector<Partial> partials(blocks);
   tbb::parallel_for(Eigen::Index(0), blocks, [&](Eigen::Index b) {
     Partial& p = partials[b];
+    Eigen::RowVectorXf buffer(data.cols());
     const Eigen::Index end = std::min(rows, (b + 1) * kBlock);
     for (Eigen::Index r = b * kBlock; r < end; ++r) {
-      const double e = (data.row(r) - reconstruction.row(r)).cast<double>().squaredNorm();
+      const double e = (data.row(r) - row(r, buffer)).template cast<double>().squaredNorm();
       p.err += e;
-      p.norm += data.row(r).cast<double>().squaredNorm();
+      p.norm += data.row(r).template cast<double>().squaredNorm();
       p.max = std::max(p.max, e);
     }
   });
@@ -47,6 +45,29 @@ ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data,
   m.relative_error = total.norm > 0 ? total.err / total.norm : 0.0;
   m.max_squared_error = total.max;
   return m;
+}
+
+}  // namespace
+
+ErrorMetrics error_metrics(const Eigen::Ref<const DataMatrix>& data,
+                           const Eigen::Ref<const DataMatrix>& reconstruction) {
+  if (data.rows() != reconstruction.rows() || data.cols() != reconstruction.cols()) {
+    throw std::invalid_argument("error_metrics: data is " + std::to_string(data.rows()) + "x" +
+                                std::to_string(data.cols()) + " but reconstruction is " +
+                                std::to_string(reconstruction.rows()) + "x" +
+                                std::to_string(reconstruction.cols()));
+  }
+  return accumulate(data,
+                    [&](Eigen::Index r, Eigen::RowVectorXf&) { return reconstruction.row(r); });
+}
+
+ErrorMetrics error_metrics_by_row(const Eigen::Ref<const DataMatrix>& data,
+                                  const std::function<void(Eigen::Index, float*)>& reconstruct) {
+  return accumulate(data,
+                    [&](Eigen::Index r, Eigen::RowVectorXf& buffer) -> const Eigen::RowVectorXf& {
+                      reconstruct(r, buffer.data());
+                      return buffer;
+                    });
 }
 
 SizeMetrics size_metrics(std::uint64_t vertices, std::uint64_t dimension, std::uint64_t clusters,
