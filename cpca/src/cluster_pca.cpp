@@ -106,22 +106,30 @@ std::vector<double> fit_clusters(const RowBlocks& x, CompressedSet& set, PcaSolv
         set.bases.data() + std::size_t(c) * std::size_t(n) * std::size_t(d), n, d);
     stored = basis.cast<float>();
     const Eigen::MatrixXd b = stored.cast<double>();
-    // The weights as stored (float), and the residual against the stored mean and basis, from
-    // the centred rows already in f: x - mean_f = f + (mean - mean_f), without reading the
-    // cluster a second time. One product for all members: row by row it cost more than the
-    // power iteration in a late step's refit.
-    const Eigen::MatrixXd w = (f * b.transpose()).cast<float>().cast<double>();  // rows x n
-    f.noalias() -= w * b;
-    f.rowwise() += mean - mean.cast<float>().cast<double>();
+    // The weights as stored (float), and each member's squared residual against the stored
+    // mean and basis, r = f + delta - w b with delta = mean - mean_f (x - mean_f = f + delta),
+    // expanded so that no d-wide residual is formed:
+    //   |r|^2 = |f|^2 + 2 f.delta + |delta|^2 - 2 w.(c + delta b^T) + w (b b^T) w^T,
+    // with c = f b^T the projections before rounding. The terms cancel in double to about
+    // 1e-16 |f|^2, below the float weights' own rounding; forming r cost a second
+    // rows x n x d product and a pass over f.
+    const Eigen::MatrixXd projections = f * b.transpose();  // rows x n
+    const Eigen::MatrixXd w = projections.cast<float>().cast<double>();
+    const Eigen::RowVectorXd delta = mean - mean.cast<float>().cast<double>();
     // Column by column: a row of f is strided, and its squared norm one serial chain of d
     // multiply-adds (a third of a small cluster's refit on the horse).
     Eigen::VectorXd squared = Eigen::VectorXd::Zero(rows);
     for (Eigen::Index j = 0; j < d; ++j) squared += f.col(j).cwiseAbs2();
+    squared += 2 * (f * delta.transpose());
+    squared.array() += delta.squaredNorm();
+    const Eigen::MatrixXd shifted = projections.rowwise() + delta * b.transpose();
+    squared -= 2 * w.cwiseProduct(shifted).rowwise().sum();
+    squared += (w * (b * b.transpose())).cwiseProduct(w).rowwise().sum();
     for (Eigen::Index i = 0; i < rows; ++i) {
       const std::uint32_t p = m[std::size_t(i)];
       for (int j = 0; j < n; ++j)
         set.weights[std::size_t(p) * std::size_t(n) + std::size_t(j)] = float(w(i, j));
-      error[p] = squared[i];
+      error[p] = std::max(0.0, squared[i]);
     }
   });
   if (stats) stats->power_iterations = iterations;
