@@ -34,6 +34,27 @@ TEST(Metrics, LargeInputIsIndependentOfThreadCountAndMatchesEigen) {
   EXPECT_NEAR(a.average_squared_error, oracle, 1e-9 * oracle);
 }
 
+TEST(Metrics, RowByRowFormEqualsTheMatrixForm) {
+  // The compressed set's metrics reconstruct one row at a time; same blocks, same arithmetic,
+  // so the same bits as the matrix form, also on one thread.
+  cpca::DataMatrix x = cpca::DataMatrix::Random(3000, 23), y = cpca::DataMatrix::Random(3000, 23);
+  const cpca::ErrorMetrics matrix = cpca::error_metrics(x, y);
+  const auto row = [&](Eigen::Index r, float* out) {
+    Eigen::Map<Eigen::RowVectorXf>(out, y.cols()) = y.row(r);
+  };
+  cpca::ErrorMetrics by_row = cpca::error_metrics_by_row(x, row), one;
+  {
+    tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+    one = cpca::error_metrics_by_row(x, row);
+  }
+  for (const cpca::ErrorMetrics& m : {by_row, one}) {
+    EXPECT_EQ(m.average_squared_error, matrix.average_squared_error);
+    EXPECT_EQ(m.relative_error, matrix.relative_error);
+    EXPECT_EQ(m.max_squared_error, matrix.max_squared_error);
+  }
+  EXPECT_EQ(cpca::error_metrics_by_row(cpca::DataMatrix(0, 4), row).average_squared_error, 0.0);
+}
+
 TEST(Metrics, ThesisSizeFormula) {
   // Bunny, order 6 glossy grey (36*36 = 1296 numbers per vertex), 256 clusters, 8 PCs.
   const cpca::SizeMetrics s = cpca::size_metrics(34835, 1296, 256, 8);
