@@ -282,6 +282,60 @@ TEST(SuperclusterRefine, FastDeltasMatchReferenceAndRecount) {
   }
 }
 
+TEST(SuperclusterRefine, UndoneTrialRestoresTheSearchExactly) {
+  // ILS runs each trial on its search and takes it back: after random moves, swaps and a
+  // descent, undo_trial() must leave the state a copy taken before it holds, member order and
+  // every pull-table delta included, and a kept trial must equal the same moves on a copy.
+  for (std::uint32_t seed = 0; seed < 20; ++seed) {
+    std::mt19937 rng(seed + 900u);
+    const int k = 4 + int(rng() % 30);
+    const int per_pass = 2 + int(rng() % 4);
+    const ClusteredMesh m = random_mesh(seed + 900u, k);
+    const cpca::ClusterIncidence inc = cpca::cluster_incidence(m.input(per_pass));
+    const int passes = (k + per_pass - 1) / per_pass + 1;
+    cpca::GroupingLocalSearch search(inc, per_pass, cpca::group_in_order(k, per_pass).pass_of,
+                                     passes);
+    for (int trial = 0; trial < 30; ++trial) {
+      const cpca::GroupingLocalSearch before = search;
+      cpca::GroupingLocalSearch replay = search;
+      const bool keep = trial % 3 == 0;
+      search.begin_trial();
+      std::vector<std::uint32_t> touched;
+      for (int step = 0; step < 1 + int(rng() % 4); ++step) {
+        const std::uint32_t c = std::uint32_t(rng() % std::uint32_t(k));
+        const std::uint32_t d = std::uint32_t(rng() % std::uint32_t(k));
+        const std::uint32_t q = std::uint32_t(rng() % std::uint32_t(passes));
+        if (int(search.members(q).size()) < per_pass && search.pass_of()[c] != q) {
+          search.move(c, q);
+          replay.move(c, q);
+        } else if (search.pass_of()[c] != search.pass_of()[d]) {
+          search.swap(c, d);
+          replay.swap(c, d);
+        }
+        touched.push_back(c);
+      }
+      search.descend(touched);
+      replay.descend(touched);
+      if (keep) {
+        search.end_trial();
+      } else {
+        search.undo_trial();
+      }
+      const cpca::GroupingLocalSearch& expect = keep ? replay : before;
+      ASSERT_EQ(search.drawn(), expect.drawn()) << "seed " << seed << " trial " << trial;
+      ASSERT_EQ(search.pass_of(), expect.pass_of());
+      for (std::uint32_t p = 0; p < std::uint32_t(passes); ++p)
+        ASSERT_EQ(search.members(p), expect.members(p)) << "pass " << p;
+      for (std::uint32_t c = 0; c < std::uint32_t(k); ++c)
+        for (std::uint32_t q = 0; q < std::uint32_t(passes); ++q)
+          ASSERT_EQ(search.delta_move(c, q), expect.delta_move(c, q));
+    }
+  }
+  const cpca::ClusterIncidence strip_incidence = cpca::cluster_incidence(strip().input(2));
+  cpca::GroupingLocalSearch idle(strip_incidence, 2, cpca::group_in_order(4, 2).pass_of, 2);
+  EXPECT_THROW(idle.undo_trial(), std::logic_error);
+}
+
 TEST(SuperclusterStrategies, OnePassDrawsEveryTriangleOnce) {
   for (std::uint32_t seed = 0; seed < 10; ++seed) {
     const int k = 1 + int(seed * 3);

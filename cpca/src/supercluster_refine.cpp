@@ -137,11 +137,10 @@ std::int64_t GroupingLocalSearch::delta_swap(std::uint32_t c, std::uint32_t d) c
          std::int64_t(pull(d, p)) + shared_correction(c, d);
 }
 
-void GroupingLocalSearch::relocate(std::uint32_t x, std::uint32_t b) {
-  const std::uint32_t a = pass_of_[x];
-  if (a == b) return;
+void GroupingLocalSearch::shift_pulls(std::uint32_t x, std::uint32_t a, std::uint32_t b) {
   // For every other cluster y of x's hyperedges, pass a stops and pass b starts pulling y
-  // through x, unless the hyperedge's third cluster already pulls from that pass.
+  // through x, unless the hyperedge's third cluster already pulls from that pass. The same
+  // call with a and b exchanged undoes it while the other clusters stay where they are.
   for (std::uint32_t i = inc_->edge_offset[x]; i < inc_->edge_offset[x + 1]; ++i) {
     const ClusterHyperedge& h = inc_->hyperedges[inc_->edge_index[i]];
     const int n = h.size();
@@ -155,10 +154,43 @@ void GroupingLocalSearch::relocate(std::uint32_t x, std::uint32_t b) {
       if (third_pass != b) pull(y, b) += h.weight;
     }
   }
+}
+
+void GroupingLocalSearch::relocate(std::uint32_t x, std::uint32_t b) {
+  const std::uint32_t a = pass_of_[x];
+  if (a == b) return;
+  shift_pulls(x, a, b);
   auto& from = members_[a];
-  from.erase(std::find(from.begin(), from.end(), x));
+  const auto at = std::find(from.begin(), from.end(), x);
+  if (journaling_) journal_.push_back({x, a, std::uint32_t(at - from.begin())});
+  from.erase(at);
   members_[b].push_back(x);
   pass_of_[x] = b;
+}
+
+void GroupingLocalSearch::begin_trial() {
+  journal_.clear();
+  journaling_ = true;
+  trial_drawn_ = drawn_;
+}
+
+void GroupingLocalSearch::undo_trial() {
+  if (!journaling_) throw std::logic_error("GroupingLocalSearch::undo_trial: no trial begun");
+  // Backwards, each relocation finds the state it left: its cluster last in its new pass.
+  for (auto r = journal_.rbegin(); r != journal_.rend(); ++r) {
+    const std::uint32_t b = pass_of_[r->cluster];
+    shift_pulls(r->cluster, b, r->from);
+    members_[b].pop_back();
+    members_[r->from].insert(members_[r->from].begin() + r->index, r->cluster);
+    pass_of_[r->cluster] = r->from;
+  }
+  drawn_ = trial_drawn_;
+  end_trial();
+}
+
+void GroupingLocalSearch::end_trial() {
+  journal_.clear();
+  journaling_ = false;
 }
 
 void GroupingLocalSearch::move(std::uint32_t c, std::uint32_t q) {

@@ -46,38 +46,43 @@ SuperClusters group_search(const ClusterIncidence& inc, int per_pass,
   GroupingLocalSearch best_found = current;
   const long iterations = long(options.kicks_per_cluster) * k_count;
   std::vector<std::uint32_t> touched;
-  // One trial state for the whole search, assigned from `current` each iteration and swapped
-  // with it on acceptance: a copy assignment reuses the buffers (the K x passes pull table and
-  // a member list per pass), where a fresh copy allocated them all again, K x 20 times.
-  GroupingLocalSearch trial = current;
+  // Each trial runs on `current` itself and is taken back when it draws more: a copy of the
+  // search per iteration (its K x passes pull table, a member list per pass), K x 20 times,
+  // cost more than most trials' moves.
   for (long it = 0; it < iterations; ++it) {
-    trial = current;
+    const std::uint64_t before = current.drawn();
+    current.begin_trial();
     touched.clear();
     const int kicks = 1 + int(rng() % 3);
     for (int kick = 0; kick < kicks; ++kick) {
       const std::uint32_t c = std::uint32_t(rng() % std::uint64_t(k_count));
-      const std::uint32_t from = trial.pass_of()[c];
+      const std::uint32_t from = current.pass_of()[c];
       const std::uint32_t lo = inc.neighbor_offset[c], hi = inc.neighbor_offset[c + 1];
       if (lo == hi) continue;
-      const std::uint32_t to = trial.pass_of()[inc.neighbor[lo + rng() % (hi - lo)]];
+      const std::uint32_t to = current.pass_of()[inc.neighbor[lo + rng() % (hi - lo)]];
       if (to == from) continue;
-      const auto& there = trial.members(to);
+      const auto& there = current.members(to);
       const std::size_t pick = rng() % (there.size() + 1);
       if (pick == there.size()) {
         if (int(there.size()) >= per_pass) continue;
-        trial.move(c, to);
+        current.move(c, to);
       } else {
         const std::uint32_t d = there[pick];
-        trial.swap(c, d);
-        trial.affected(d, to, touched);
+        current.swap(c, d);
+        current.affected(d, to, touched);
       }
-      trial.affected(c, from, touched);
+      current.affected(c, from, touched);
     }
-    if (touched.empty()) continue;
-    trial.descend(touched);
-    if (trial.drawn() <= current.drawn()) {
-      std::swap(current, trial);
+    if (touched.empty()) {
+      current.end_trial();
+      continue;
+    }
+    current.descend(touched);
+    if (current.drawn() <= before) {
+      current.end_trial();
       if (current.drawn() < best_found.drawn()) best_found = current;
+    } else {
+      current.undo_trial();
     }
   }
   best_found.descend_fully();  // the cheap worklist descents may stop short of an optimum

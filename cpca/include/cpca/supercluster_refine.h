@@ -53,6 +53,15 @@ class GroupingLocalSearch {
   // swaps. Returns the steps applied.
   int descend_fully();
 
+  // A trial the caller may take back. The moves and swaps made after begin_trial() are
+  // journaled; undo_trial() replays them backwards and restores the state exactly, member
+  // order included, so a search that goes on is the one it would have been from a copy made
+  // before the trial, at the cost of the trial's moves instead of a copy of the K x passes
+  // pull table. end_trial() keeps the moves.
+  void begin_trial();
+  void undo_trial();
+  void end_trial();
+
   // Clusters to re-examine after c changed pass: c, its neighbours (their deltas changed)
   // and the members of its old and new pass (their room and partners changed). Appended to
   // `out`. A cluster elsewhere whose best swap partner is now c is not re-examined, so
@@ -78,6 +87,13 @@ class GroupingLocalSearch {
     return pull_[c * members_.size() + q];
   }
   void relocate(std::uint32_t c, std::uint32_t q);  // pass_of_, members_, pull_; not drawn_
+  void shift_pulls(std::uint32_t x, std::uint32_t a, std::uint32_t b);  // x from pass a to b
+  struct Relocation {
+    std::uint32_t cluster, from, index;  // index: its place among `from`'s members
+  };
+  std::vector<Relocation> journal_;
+  bool journaling_ = false;
+  std::uint64_t trial_drawn_ = 0;
   std::int64_t shared_correction(std::uint32_t c, std::uint32_t d) const;
 };
 
