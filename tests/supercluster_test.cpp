@@ -187,6 +187,31 @@ ClusteredMesh random_mesh(std::uint32_t seed, int cluster_count) {
   return m;
 }
 
+// A random case for the local search: K = min_k + [0, k_span), per pass 2 + [0, pass_span),
+// random_mesh of that K and its incidence, and the generator for the test's further draws.
+struct RandomCase {
+  std::mt19937 rng;
+  int k = 0, per_pass = 0;
+  ClusteredMesh mesh;
+  cpca::ClusterIncidence inc;
+};
+RandomCase random_case(std::uint32_t seed, int min_k, int k_span, int pass_span) {
+  RandomCase rc;
+  rc.rng.seed(seed);
+  rc.k = min_k + int(rc.rng() % std::uint32_t(k_span));
+  rc.per_pass = 2 + int(rc.rng() % std::uint32_t(pass_span));
+  rc.mesh = random_mesh(seed, rc.k);
+  rc.inc = cpca::cluster_incidence(rc.mesh.input(rc.per_pass));
+  return rc;
+}
+
+// Clusters grouped in id order, with one pass to spare so that moves are possible.
+cpca::GroupingLocalSearch in_order_search(const RandomCase& rc) {
+  return cpca::GroupingLocalSearch(rc.inc, rc.per_pass,
+                                   cpca::group_in_order(rc.k, rc.per_pass).pass_of,
+                                   (rc.k + rc.per_pass - 1) / rc.per_pass + 1);
+}
+
 TEST(SuperclusterStrategies, CapacityAndCoverageOnRandomInputs) {
   for (std::uint32_t seed = 0; seed < 60; ++seed) {
     std::mt19937 rng(seed * 7919u + 1u);
@@ -220,11 +245,10 @@ TEST(SuperclusterStrategies, CapacityAndCoverageOnRandomInputs) {
 
 TEST(SuperclusterStrategies, RefinementNeverWorseThanItsStart) {
   for (std::uint32_t seed = 0; seed < 60; ++seed) {
-    std::mt19937 rng(seed + 1000u);
-    const int k = 4 + int(rng() % 60);
-    const int per_pass = 2 + int(rng() % 6);
-    const ClusteredMesh m = random_mesh(seed + 1000u, k);
-    const cpca::ClusterIncidence inc = cpca::cluster_incidence(m.input(per_pass));
+    const RandomCase rc = random_case(seed + 1000u, 4, 60, 6);
+    const int per_pass = rc.per_pass;
+    const ClusteredMesh& m = rc.mesh;
+    const cpca::ClusterIncidence& inc = rc.inc;
     SCOPED_TRACE("seed " + std::to_string(seed));
     const std::uint64_t metis_raw = drawn(m, cpca::group_metis(inc, per_pass, {.refine = false}));
     const std::uint64_t metis = drawn(m, cpca::group_metis(inc, per_pass));
@@ -243,14 +267,12 @@ TEST(SuperclusterRefine, FastDeltasMatchReferenceAndRecount) {
   // The pull table is updated incrementally; after every random step, each fast delta must
   // equal the hyperedge recount, and drawn() the full recount (all integers: exact).
   for (std::uint32_t seed = 0; seed < 20; ++seed) {
-    std::mt19937 rng(seed + 500u);
-    const int k = 3 + int(rng() % 30);
-    const int per_pass = 2 + int(rng() % 4);
-    const ClusteredMesh m = random_mesh(seed + 500u, k);
-    const cpca::ClusterIncidence inc = cpca::cluster_incidence(m.input(per_pass));
-    const int passes = (k + per_pass - 1) / per_pass + 1;  // one spare pass: moves possible
-    const SuperClusters start = cpca::group_in_order(k, per_pass);
-    cpca::GroupingLocalSearch search(inc, per_pass, start.pass_of, passes);
+    RandomCase rc = random_case(seed + 500u, 3, 30, 4);
+    std::mt19937& rng = rc.rng;
+    const int k = rc.k, per_pass = rc.per_pass;
+    const cpca::ClusterIncidence& inc = rc.inc;
+    cpca::GroupingLocalSearch search = in_order_search(rc);
+    const int passes = search.pass_count();
     for (int step = 0; step < 200; ++step) {
       const std::uint32_t c = std::uint32_t(rng() % std::uint32_t(k));
       const std::uint32_t d = std::uint32_t(rng() % std::uint32_t(k));
@@ -287,14 +309,11 @@ TEST(SuperclusterRefine, UndoneTrialRestoresTheSearchExactly) {
   // descent, undo_trial() must leave the state a copy taken before it holds, member order and
   // every pull-table delta included, and a kept trial must equal the same moves on a copy.
   for (std::uint32_t seed = 0; seed < 20; ++seed) {
-    std::mt19937 rng(seed + 900u);
-    const int k = 4 + int(rng() % 30);
-    const int per_pass = 2 + int(rng() % 4);
-    const ClusteredMesh m = random_mesh(seed + 900u, k);
-    const cpca::ClusterIncidence inc = cpca::cluster_incidence(m.input(per_pass));
-    const int passes = (k + per_pass - 1) / per_pass + 1;
-    cpca::GroupingLocalSearch search(inc, per_pass, cpca::group_in_order(k, per_pass).pass_of,
-                                     passes);
+    RandomCase rc = random_case(seed + 900u, 4, 30, 4);
+    std::mt19937& rng = rc.rng;
+    const int k = rc.k, per_pass = rc.per_pass;
+    cpca::GroupingLocalSearch search = in_order_search(rc);
+    const int passes = search.pass_count();
     for (int trial = 0; trial < 30; ++trial) {
       const cpca::GroupingLocalSearch before = search;
       cpca::GroupingLocalSearch replay = search;
