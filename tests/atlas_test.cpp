@@ -173,6 +173,42 @@ TEST(Atlas, TexelPointsAreTheSurfaceUnderEachTexel) {
   EXPECT_THROW(meshes::texel_points(fewer, atlas), std::invalid_argument);
 }
 
+// A texel's normal is the unit vertex normal interpolated at its point: on a torus, the
+// direction from the tube's centre line through the point (to the facets' deviation), the
+// face's where the mesh has no normals, and zero where no triangle reads the texel.
+TEST(Atlas, TexelNormalsAreTheShadingNormalsAtEachPoint) {
+  const Mesh mesh = meshes::make_torus(1.f, 0.35f, 24, 12);
+  ASSERT_TRUE(mesh.has_frames());
+  const Atlas atlas = meshes::make_atlas(mesh, 128, 128);
+  const std::vector<Eigen::Vector3f> points = meshes::texel_points(mesh, atlas);
+  const std::vector<Eigen::Vector3f> normals = meshes::texel_normals(mesh, atlas);
+  Mesh bare = mesh;
+  bare.normals.clear();
+  bare.tangents.clear();
+  const std::vector<Eigen::Vector3f> faces = meshes::texel_normals(bare, atlas);
+  ASSERT_EQ(normals.size(), points.size());
+  int used = 0;
+  for (std::size_t t = 0; t < normals.size(); ++t) {
+    const int triangle = atlas.texel_triangle[t];
+    if (triangle < 0) {
+      EXPECT_EQ(normals[t], Eigen::Vector3f::Zero());
+      continue;
+    }
+    ++used;
+    const Eigen::Vector3f p = points[t];
+    const Eigen::Vector3f ring = Eigen::Vector3f(p.x(), 0.f, p.z()).normalized();
+    const Eigen::Vector3f outward = (p - ring).normalized();
+    EXPECT_NEAR(normals[t].norm(), 1.f, 1e-5f) << "texel " << t;
+    EXPECT_GT(normals[t].dot(outward), 0.995f) << "texel " << t;
+    const meshes::Triangle& tri = mesh.triangles[std::size_t(triangle)];
+    const Eigen::Vector3f face = (mesh.positions[tri[1]] - mesh.positions[tri[0]])
+                                     .cross(mesh.positions[tri[2]] - mesh.positions[tri[0]])
+                                     .normalized();
+    EXPECT_LT((faces[t] - face).norm(), 1e-5f) << "texel " << t;
+  }
+  EXPECT_GT(used, 128 * 128 / 3);
+}
+
 TEST(Atlas, DegenerateTrianglesGetAChartAndOwnTexels) {
   const Mesh mesh = test_mesh();
   const Atlas atlas = meshes::make_atlas(mesh, 128, 96, kPerTriangle);

@@ -201,29 +201,55 @@ std::size_t Atlas::used_texels() const {
                                    [](std::int32_t t) { return t >= 0; }));
 }
 
-std::vector<Eigen::Vector3f> texel_points(const Mesh& mesh, const Atlas& atlas) {
+namespace {
+
+// Per texel, `at(triangle, barycentrics)`; zero where no triangle reads it. `what` names the
+// caller in messages.
+template <typename At>
+std::vector<Eigen::Vector3f> per_texel(const Mesh& mesh, const Atlas& atlas, const char* what,
+                                       const At& at) {
   const std::size_t texels = std::size_t(atlas.width) * std::size_t(atlas.height);
   if (atlas.texel_triangle.size() != texels || atlas.texel_barycentric.size() != texels)
-    throw std::invalid_argument("texel points: the atlas names the triangles of " +
+    throw std::invalid_argument(std::string(what) + ": the atlas names the triangles of " +
                                 std::to_string(atlas.texel_triangle.size()) +
                                 " and the points of " +
                                 std::to_string(atlas.texel_barycentric.size()) + " texels; its " +
                                 std::to_string(atlas.width) + " x " + std::to_string(atlas.height) +
                                 " map has " + std::to_string(texels));
-  std::vector<Eigen::Vector3f> points(texels, Eigen::Vector3f::Zero());
+  std::vector<Eigen::Vector3f> values(texels, Eigen::Vector3f::Zero());
   for (std::size_t t = 0; t < texels; ++t) {
     const std::int32_t triangle = atlas.texel_triangle[t];
     if (triangle < 0) continue;
     if (std::size_t(triangle) >= mesh.triangle_count())
-      throw std::invalid_argument("texel points: texel " + std::to_string(t) + " names triangle " +
-                                  std::to_string(triangle) + " of " +
+      throw std::invalid_argument(std::string(what) + ": texel " + std::to_string(t) +
+                                  " names triangle " + std::to_string(triangle) + " of " +
                                   std::to_string(mesh.triangle_count()));
-    const Triangle& tri = mesh.triangles[std::size_t(triangle)];
-    const Eigen::Vector2f b = atlas.texel_barycentric[t];
-    points[t] = (1.f - b.x() - b.y()) * mesh.positions[tri[0]] + b.x() * mesh.positions[tri[1]] +
-                b.y() * mesh.positions[tri[2]];
+    values[t] = at(mesh.triangles[std::size_t(triangle)], atlas.texel_barycentric[t]);
   }
-  return points;
+  return values;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3f> texel_points(const Mesh& mesh, const Atlas& atlas) {
+  return per_texel(mesh, atlas, "texel points", [&](const Triangle& tri, const Eigen::Vector2f& b) {
+    return Eigen::Vector3f((1.f - b.x() - b.y()) * mesh.positions[tri[0]] +
+                           b.x() * mesh.positions[tri[1]] + b.y() * mesh.positions[tri[2]]);
+  });
+}
+
+std::vector<Eigen::Vector3f> texel_normals(const Mesh& mesh, const Atlas& atlas) {
+  return per_texel(
+      mesh, atlas, "texel normals", [&](const Triangle& tri, const Eigen::Vector2f& b) {
+        const Eigen::Vector3f face = (mesh.positions[tri[1]] - mesh.positions[tri[0]])
+                                         .cross(mesh.positions[tri[2]] - mesh.positions[tri[0]]);
+        const Eigen::Vector3f face_unit =
+            face.norm() > 0.f ? Eigen::Vector3f(face.normalized()) : Eigen::Vector3f::UnitY();
+        if (!mesh.has_frames()) return face_unit;
+        const Eigen::Vector3f n = (1.f - b.x() - b.y()) * mesh.normals[tri[0]] +
+                                  b.x() * mesh.normals[tri[1]] + b.y() * mesh.normals[tri[2]];
+        return n.norm() > 1e-6f ? Eigen::Vector3f(n.normalized()) : face_unit;
+      });
 }
 
 Atlas make_atlas(const Mesh& mesh, int width, int height, const AtlasOptions& options) {

@@ -60,6 +60,10 @@ struct Atlas {
 // no triangle reads it. `mesh` is the one the atlas was made from (std::invalid_argument
 // when the sizes say otherwise).
 std::vector<Eigen::Vector3f> texel_points(const Mesh& mesh, const Atlas& atlas);
+// Per texel, the unit shading normal there: the vertex normals interpolated and normalised,
+// the face's where the mesh has none or they cancel (prt::PathTracer::surface_point's rule);
+// (0, 0, 0) where no triangle reads it.
+std::vector<Eigen::Vector3f> texel_normals(const Mesh& mesh, const Atlas& atlas);
 
 // An atlas of at most width x height texels, the same for the same mesh and options. Throws
 // std::invalid_argument when the size is out of range or too small to hold every chart.
