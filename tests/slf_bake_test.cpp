@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 namespace {
 
@@ -231,11 +232,62 @@ TEST(SlfBake, TheFileRecordsTheChartsAndLightSamplesAndOlderVersionsRead) {
       test_support::write_scratch("slf_bake", "charts.slf", as_version(bytes, 2, 7)), read,
       "atlas chart method 7 is unknown");
   test_support::error_of<prt::SlfFileError>(
-      test_support::write_scratch("slf_bake", "v4.slf", as_version(bytes, 4, 0)), read,
+      test_support::write_scratch("slf_bake", "v5.slf", as_version(bytes, 5, 0)), read,
       "newer prtr version");
   test_support::error_of<prt::SlfFileError>(
       test_support::write_scratch("slf_bake", "v0.slf", as_version(bytes, 0, 0)), read,
-      "reads versions 1 to 3");
+      "reads versions 1 to 4");
+}
+
+// The grid's direction space is recorded at 46 (a u16 beside the masking at 44 since version
+// 4); versions 1 to 3, whose u32 masking left 46-47 zero, read as view directions, and a space
+// no build knows is refused.
+TEST(SlfBake, TheFileRecordsTheDirectionSpace) {
+  const Scene s;
+  prt::SlfBakeOptions o = lambert_options(1);
+  o.grid.space = prt::SlfDirectionSpace::kReflected;
+  o.material.masking = prt::Masking::kVGroove;
+  const fs::path path = scratch("slf_bake", "reflected.slf");
+  prt::bake_slf_to_file(s.mesh, s.atlas, s.sky, o, path);
+  const prt::SlfMatrix reflected = prt::read_slf(path);
+  EXPECT_EQ(reflected.shape.grid.space, prt::SlfDirectionSpace::kReflected);
+  EXPECT_EQ(reflected.shape.material.masking, prt::Masking::kVGroove);
+  std::string bytes = test_support::slurp(path);
+  const auto read = [](const fs::path& p) { prt::read_slf(p); };
+  const std::uint16_t unknown = 7;
+  std::memcpy(bytes.data() + 46, &unknown, 2);
+  test_support::error_of<prt::SlfFileError>(
+      test_support::write_scratch("slf_bake", "space7.slf", as_version(bytes, 4, 0)), read,
+      "direction space 7 is unknown");
+  const std::uint16_t zero = 0;
+  std::memcpy(bytes.data() + 46, &zero, 2);
+  const prt::SlfMatrix v3 =
+      prt::read_slf(test_support::write_scratch("slf_bake", "v3.slf", as_version(bytes, 3, 0)));
+  EXPECT_EQ(v3.shape.grid.space, prt::SlfDirectionSpace::kView);
+  EXPECT_EQ(v3.shape.material.masking, prt::Masking::kVGroove);
+}
+
+// Reflection about the normal is its own inverse and keeps the angle to the normal, so a
+// cell's views are as far from the horizon as the cell; a grid of views is the identity.
+TEST(SlfDirections, ReflectedSpaceMirrorsAboutTheNormal) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> g;
+  prt::SlfGrid reflected;
+  reflected.space = prt::SlfDirectionSpace::kReflected;
+  const prt::SlfGrid view;
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Vector3d n = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const Eigen::Vector3d v = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const Eigen::Vector3d r = prt::slf_grid_space(reflected, v, n);
+    EXPECT_NEAR(r.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(r.dot(n), v.dot(n), 1e-12);
+    EXPECT_NEAR((r + v - 2 * v.dot(n) * n).norm(), 0.0, 1e-12);  // v's tangent part flipped
+    EXPECT_LT((prt::slf_grid_space(reflected, r, n) - v).norm(), 1e-12);
+    EXPECT_EQ(prt::slf_grid_space(view, v, n), v);
+  }
+  // Toward the normal, the view is its own reflection.
+  const Eigen::Vector3d n(0, 1, 0);
+  EXPECT_LT((prt::slf_grid_space(reflected, n, n) - n).norm(), 1e-15);
 }
 
 TEST(SlfBake, DamagedFilesAreRefusedNamingTheFile) {

@@ -718,6 +718,86 @@ TEST(SlfRenderer, AutomaticShadingFollowsTheCostOfEachPath) {
   }
 }
 
+// A grid of reflected directions: each texel looks its view up mirrored about its own
+// normal, in the CPU reference (against the view-grid model looked up at the mirror image by
+// hand) and on every GL path (against that reference).
+render::SlfModel reflected(render::SlfModel m) {
+  m.grid.space = prt::SlfDirectionSpace::kReflected;
+  m.texel_normals = render::texel_normals_from_uv(m);
+  return m;
+}
+
+TEST(SlfReference, ReflectedGridLooksUpEachTexelsMirrorImage) {
+  const render::SlfModel view = sphere_model();
+  const render::SlfModel mirrored = reflected(view);
+  EXPECT_NO_THROW(mirrored.validate());
+  const Vector3d eye(0.4, 1.5, 2.5);
+  const int side = view.map_width;
+  int checked = 0;
+  for (int x : {20, 33, 47, 70, 101})
+    for (int y : {12, 30, 51, 88, 113}) {
+      const std::size_t t = std::size_t(y) * side + std::size_t(x);
+      if (view.texel_cluster[t] < 0) continue;
+      const Vector2f centre((x + 0.5f) / side, (y + 0.5f) / side);
+      const Vector3d n = mirrored.texel_normals[t].cast<double>();
+      // On this sphere the normal is the point's direction from the centre.
+      EXPECT_LT((n - view.texel_positions[t].cast<double>().normalized()).norm(), 0.02);
+      const Vector3d d = (eye - view.texel_positions[t].cast<double>()).normalized();
+      const Vector3f expected = render::slf_radiance(view, centre, 2 * n.dot(d) * n - d);
+      EXPECT_LT((render::slf_radiance_toward(mirrored, centre, eye) - expected).norm(),
+                1e-5 * expected.norm())
+          << x << ", " << y;
+      // The fragment's direction is mirrored about the texel's normal too.
+      EXPECT_LT((render::slf_radiance(mirrored, centre, 3.0 * d) - expected).norm(),
+                1e-5 * expected.norm());
+      ++checked;
+    }
+  EXPECT_GT(checked, 10);
+  // Reflected directions need each texel's normal; view directions take none.
+  render::SlfModel bad = mirrored;
+  bad.texel_normals.clear();
+  expect_refused(bad, "texel_normals");
+  bad = view;
+  bad.texel_normals = mirrored.texel_normals;
+  expect_refused(bad, "texel_normals");
+}
+
+TEST(SlfRenderer, ReflectedGridMatchesTheCpuReferenceOnEveryPath) {
+  render::GlContext ctx;
+  const render::SlfModel model = reflected(sphere_model());
+  const render::SlfReferenceOptions reference_options{true, Vector3f(0.1f, 0.2f, 0.3f)};
+  render::SlfReferenceOptions per_texel = reference_options;
+  per_texel.texel_directions = true;
+  render::Background background;
+  background.use_probe = false;
+  background.colour = render::Rgb(0.1f, 0.2f, 0.3f);
+  for (const Vector3d& eye : {Vector3d(0.3, 0.2, 3.5), Vector3d(-2.0, 2.4, 1.0)}) {
+    const render::Camera camera = camera_at(eye, 80, 60);
+    const render::Image cpu = render::render_slf_reference(model, camera, reference_options);
+    const render::Image cpu_per_texel = render::render_slf_reference(model, camera, per_texel);
+    for (const auto& [shading, fast] : kVariants) {
+      render::GlDebugLog log;
+      render::SlfRenderer renderer(model, nullptr, {true, fast, shading});
+      renderer.set_background(background);
+      renderer.render(camera);
+      EXPECT_EQ(renderer.shading(), shading);
+      const bool texel_space = shading == render::SlfShading::kTextureSpace;
+      const Comparison c =
+          compare(renderer.read_image(), texel_space ? cpu_per_texel : cpu, kImageTolerance);
+      const std::string label = std::string(render::kSlfShadingNames.name(shading)) +
+                                (fast ? ", shared-cluster path asked" : "");
+      EXPECT_GT(c.covered, camera.width * camera.height / 8) << label;
+      EXPECT_LE(c.coverage_differs + c.value_differs, kEdgePixels)
+          << label << " (worst of the others " << c.worst << ")";
+      EXPECT_TRUE(log.messages().empty()) << label << ": " << log.messages().front();
+    }
+    // The view grid's image differs: the lookup really is mirrored.
+    const render::Image unmirrored =
+        render::render_slf_reference(sphere_model(), camera, reference_options);
+    EXPECT_GT(compare(unmirrored, cpu, 0.01).value_differs, 100);
+  }
+}
+
 // The CPU reference's per-texel directions: at a texel centre the texel alone, toward the
 // eye from its own point; between centres the bilinear blend of the four, each so.
 TEST(SlfReference, TexelDirectionsBlendEachTexelTowardTheEye) {

@@ -42,7 +42,7 @@ std::uint64_t bake_key(const meshes::Mesh& mesh, const probes::Probe& probe, con
         std::int64_t(o.grid.elevation), std::int64_t(o.spp), std::int64_t(o.bounces),
         std::int64_t(o.seed), std::int64_t(o.first_row), std::int64_t(o.end_row),
         std::int64_t(o.material.kind), std::int64_t(o.material.masking), std::int64_t(s.charts),
-        std::int64_t(o.light_samples)})
+        std::int64_t(o.light_samples), std::int64_t(o.grid.space)})
     hash_value(h, v);
   for (float v : {o.material.albedo.x(), o.material.albedo.y(), o.material.albedo.z(),
                   o.material.specular, o.material.exponent, o.material.roughness, o.material.f0})
@@ -81,12 +81,14 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
     std::snprintf(
         line, sizeof line,
         "slf: %dx%d atlas (%d %s charts), %llu of %llu texels used (%zu triangles); %llu rows x "
-        "%d directions x %d spp, %d bounce(s); %s of radiance",
+        "%d %sdirections x %d spp, %d bounce(s); %s of radiance",
         atlas.width, atlas.height, atlas.chart_count, meshes::kAtlasChartsNames.name(atlas.charts),
         static_cast<unsigned long long>(rows),
         static_cast<unsigned long long>(std::uint64_t(atlas.width) * atlas.height),
         mesh.triangles.size(), static_cast<unsigned long long>(count),
-        settings.bake.grid.directions(), settings.bake.spp, settings.bake.bounces,
+        settings.bake.grid.directions(),
+        settings.bake.grid.space == prt::SlfDirectionSpace::kReflected ? "reflected " : "",
+        settings.bake.spp, settings.bake.bounces,
         common::format_bytes(count * columns * 4).c_str());
     reporter.tell(line);
   }

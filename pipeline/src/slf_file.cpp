@@ -76,7 +76,7 @@ std::string slfc_problem(const CompressedSlf& slf) {
   if (b.atlas_width < 4 || b.atlas_width > 8192 || b.atlas_height < 4 || b.atlas_height > 8192)
     return "atlas size " + std::to_string(b.atlas_width) + " x " + std::to_string(b.atlas_height) +
            " is outside [4, 8192]";
-  if (std::string problem = prt::slf_charts_problem(b); !problem.empty()) return problem;
+  if (std::string problem = prt::slf_layout_problem(b); !problem.empty()) return problem;
   try {
     b.grid.validate();
     b.material.validate();
@@ -180,7 +180,7 @@ CompressedSlf read_slfc(const std::filesystem::path& path) {
       b.rows > std::uint64_t(b.atlas_width) * std::uint64_t(b.atlas_height) || clusters < 1 ||
       clusters > b.rows || path_bytes > kMaxSlfcNameBytes || name_bytes > kMaxSlfcNameBytes)
     throw fail("header fields out of range" + damaged);
-  if (const std::string problem = prt::slf_charts_problem(b); !problem.empty())
+  if (const std::string problem = prt::slf_layout_problem(b); !problem.empty())
     throw fail("header field " + problem + damaged);
   if (const std::string problem = common::header_checksum_problem(h, kSlfcFormat); !problem.empty())
     throw fail(problem);

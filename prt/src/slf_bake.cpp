@@ -41,10 +41,11 @@ constexpr common::VersionedFormat kSlfFormat{"surface light field file",
 constexpr std::size_t kSlfOffWidth = 16, kSlfOffCharts = 18, kSlfOffHeight = 20,
                       kSlfOffAzimuth = 24, kSlfOffElevation = 28, kSlfOffSpp = 32,
                       kSlfOffBounces = 36, kSlfOffLightSamples = 38, kSlfOffKind = 40,
-                      kSlfOffMasking = 44, kSlfOffSeed = 48, kSlfOffMeshHash = 56,
-                      kSlfOffAlbedo = 64, kSlfOffSpecular = 76, kSlfOffExponent = 80,
-                      kSlfOffRoughness = 84, kSlfOffF0 = 88, kSlfOffRows = 92, kSlfOffFirstRow = 96,
-                      kSlfOffRowCount = 100, kSlfOffPayloadChecksum = 104, kSlfOffProbeHash = 112;
+                      kSlfOffMasking = 44, kSlfOffSpace = 46, kSlfOffSeed = 48,
+                      kSlfOffMeshHash = 56, kSlfOffAlbedo = 64, kSlfOffSpecular = 76,
+                      kSlfOffExponent = 80, kSlfOffRoughness = 84, kSlfOffF0 = 88, kSlfOffRows = 92,
+                      kSlfOffFirstRow = 96, kSlfOffRowCount = 100, kSlfOffPayloadChecksum = 104,
+                      kSlfOffProbeHash = 112;
 constexpr int kMaxSpp = 65536;
 constexpr float kSlfMaxRadiance = 1e20f;
 
@@ -60,7 +61,8 @@ void put_slf_settings(common::VersionedHeader& h, const SlfShape& s) {
   common::put_field(h, kSlfOffBounces, std::uint16_t(s.bounces));
   common::put_field(h, kSlfOffLightSamples, std::uint16_t(s.light_samples));
   common::put_field(h, kSlfOffKind, std::uint32_t(s.material.kind));
-  common::put_field(h, kSlfOffMasking, std::uint32_t(s.material.masking));
+  common::put_field(h, kSlfOffMasking, std::uint16_t(s.material.masking));
+  common::put_field(h, kSlfOffSpace, std::uint16_t(s.grid.space));
   common::put_field(h, kSlfOffMeshHash, s.mesh_hash);
   for (int c = 0; c < 3; ++c) common::put_field(h, kSlfOffAlbedo + 4 * c, s.material.albedo[c]);
   common::put_field(h, kSlfOffSpecular, s.material.specular);
@@ -93,7 +95,13 @@ void get_slf_settings(const common::VersionedHeader& h, SlfShape& s) {
     s.light_samples = 0;
   }
   s.material.kind = MaterialKind(common::get_field<std::uint32_t>(h, kSlfOffKind));
-  s.material.masking = Masking(common::get_field<std::uint32_t>(h, kSlfOffMasking));
+  if (common::header_version(h) >= 4) {
+    s.material.masking = Masking(common::get_field<std::uint16_t>(h, kSlfOffMasking));
+    s.grid.space = SlfDirectionSpace(common::get_field<std::uint16_t>(h, kSlfOffSpace));
+  } else {
+    s.material.masking = Masking(common::get_field<std::uint32_t>(h, kSlfOffMasking));
+    s.grid.space = SlfDirectionSpace::kView;
+  }
   s.mesh_hash = common::get_field<std::uint64_t>(h, kSlfOffMeshHash);
   for (int c = 0; c < 3; ++c)
     s.material.albedo[c] = common::get_field<float>(h, kSlfOffAlbedo + 4 * c);
@@ -104,7 +112,12 @@ void get_slf_settings(const common::VersionedHeader& h, SlfShape& s) {
   s.probe_hash = common::get_field<std::uint64_t>(h, kSlfOffProbeHash);
 }
 
-std::string slf_charts_problem(const SlfShape& s) {
+std::string slf_layout_problem(const SlfShape& s) {
+  bool space_known = false;
+  for (const auto& entry : kSlfDirectionSpaceNames.entries)
+    space_known |= entry.value == s.grid.space;
+  if (!space_known)
+    return "direction space " + std::to_string(std::uint32_t(s.grid.space)) + " is unknown";
   for (const auto& entry : meshes::kAtlasChartsNames.entries)
     if (entry.value == s.charts) return {};
   return "atlas chart method " + std::to_string(std::uint32_t(s.charts)) + " is unknown";
@@ -132,7 +145,7 @@ std::string shape_problem(const SlfShape& s) {
   if (!in(std::uint64_t(s.atlas_width), 4, 8192) || !in(std::uint64_t(s.atlas_height), 4, 8192))
     return "atlas size " + std::to_string(s.atlas_width) + " x " + std::to_string(s.atlas_height) +
            " is outside [4, 8192]";
-  if (std::string problem = slf_charts_problem(s); !problem.empty()) return problem;
+  if (std::string problem = slf_layout_problem(s); !problem.empty()) return problem;
   if (!in(std::uint64_t(s.grid.azimuth), 1, 4096) || !in(std::uint64_t(s.grid.elevation), 1, 4096))
     return "direction grid " + std::to_string(s.grid.azimuth) + " x " +
            std::to_string(s.grid.elevation) + " is outside [1, 4096]";
@@ -248,7 +261,9 @@ Eigen::Vector3d cell_direction(const SlfGrid& grid, const GridCell& cell, double
 // technique is light_samples x spp probe samples shared by all of the texel's cells (one
 // shadow ray each, prt::SharedLights), each cell pairing every one of them with its own view,
 // again stratified over the cell: per cell as many light-view pairs as the paths' own light
-// samples would give light_samples times over, for the price of BRDF evaluations.
+// samples would give light_samples times over, for the price of BRDF evaluations. In the
+// reflected space a cell's samples are mirrored about the shading normal into views
+// (prt/slf_directions.h), uniform over the cell's image since reflection keeps solid angle.
 void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_t texel,
               std::uint64_t row, const SlfBakeOptions& o, float* out) {
   const int directions = o.grid.directions();
@@ -266,6 +281,10 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       o.light_samples > 0 ? tracer.sample_lights(point, shared, mix_key(row_key, 0x11647ULL))
                           : SharedLights{};
   const double ratio = lights.size() > 0 ? double(o.light_samples) : 0.0;
+  const Eigen::Vector3d normal = point.frame.col(2);
+  const auto view_at = [&](const GridCell& cell, const Eigen::Vector2d& ab) {
+    return slf_grid_space(o.grid, cell_direction(o.grid, cell, ab.x(), ab.y()), normal);
+  };
   for (int column = 0; column < directions; ++column) {
     const GridCell cell(o.grid, column);
     const std::uint64_t column_key = mix_key(row_key, std::uint64_t(column));
@@ -273,7 +292,7 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       const std::uint64_t key = mix_key(column_key, std::uint64_t(k));
       RandomStream jitter{key, 0};
       const Eigen::Vector2d ab = stratified_point(k, o.spp, jitter);
-      ExitQuery q{point, cell_direction(o.grid, cell, ab.x(), ab.y()), key, std::uint32_t(column)};
+      ExitQuery q{point, view_at(cell, ab), key, std::uint32_t(column)};
       q.shared_light_ratio = ratio;
       queries.push_back(q);
     }
@@ -293,7 +312,7 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       for (std::uint32_t l = 0; l < std::uint32_t(shared); ++l) {
         if (!lights.lit(l)) continue;
         const Eigen::Vector2d ab = sobol02(l, shift_x, shift_y);
-        views.push_back(cell_direction(o.grid, cell, ab.x(), ab.y()));
+        views.push_back(view_at(cell, ab));
         lights_of.push_back(l);
       }
       sums[std::size_t(column)] +=

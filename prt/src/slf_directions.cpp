@@ -35,4 +35,10 @@ Eigen::Vector3d slf_grid_direction(const SlfGrid& grid, int column) {
   return slf_direction(2.0 * (i + 0.5) / grid.azimuth, (j + 0.5) / grid.elevation);
 }
 
+Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
+                               const Eigen::Vector3d& normal) {
+  if (grid.space == SlfDirectionSpace::kView) return view;
+  return 2.0 * normal.dot(view) * normal - view;
+}
+
 }  // namespace prt

@@ -88,13 +88,34 @@ void SlfModel::validate() const {
     if (!texel_positions[t].allFinite())
       slf_model_checks::refuse("texel_positions[" + std::to_string(t) +
                                "] is not finite; rebuild the model from finite data");
+  if (grid.space == prt::SlfDirectionSpace::kReflected) {
+    slf_model_checks::check_size(texel_normals.size(), texels, "texel_normals",
+                                 "one per texel (map_width x map_height) for reflected directions");
+    for (std::size_t t = 0; t < texels; ++t)
+      if (texel_cluster[t] >= 0 && !(std::abs(texel_normals[t].squaredNorm() - 1.f) < 1e-3f))
+        slf_model_checks::refuse("texel_normals[" + std::to_string(t) +
+                                 "] is not a unit vector; rebuild the model from finite data");
+  } else if (!texel_normals.empty()) {
+    slf_model_checks::refuse(
+        "texel_normals is given for a grid of view directions; only "
+        "reflected directions use it");
+  }
   slf_model_checks::check_finite(texel_weights, "texel_weights");
   slf_model_checks::check_finite(view_maps, "view_maps");
 }
 
-std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model) {
+namespace {
+
+// Per texel read by some triangle, where its point lies: the first corner 3 t of its triangle
+// and barycentrics (u, v); corner -1 elsewhere.
+struct TexelOnTriangle {
+  std::int64_t corner = -1;
+  float u = 0, v = 0;
+};
+
+std::vector<TexelOnTriangle> texels_on_triangles(const SlfModel& model) {
   const std::size_t texels = std::size_t(model.map_width) * std::size_t(model.map_height);
-  std::vector<Eigen::Vector3f> points(texels, Eigen::Vector3f::Zero());
+  std::vector<TexelOnTriangle> on(texels);
   // Squared uv distance (in texels) from each texel centre to the triangle giving its point.
   std::vector<float> best(texels, std::numeric_limits<float>::infinity());
   const Eigen::Vector2f scale(float(model.map_width), float(model.map_height));
@@ -131,11 +152,37 @@ std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model) {
         const float distance = (a + u * e1 + v * e2 - (q + a)).squaredNorm();
         if (!(distance < best[texel])) continue;
         best[texel] = distance;
-        points[texel] = (1.f - u - v) * model.positions[t] + u * model.positions[t + 1] +
-                        v * model.positions[t + 2];
+        on[texel] = {std::int64_t(t), u, v};
       }
   }
-  return points;
+  return on;
+}
+
+// Corner values `of` (3 per triangle) interpolated at each texel's point.
+std::vector<Eigen::Vector3f> lerp_at_texels(const SlfModel& model,
+                                            const std::vector<Eigen::Vector3f>& of) {
+  const std::vector<TexelOnTriangle> on = texels_on_triangles(model);
+  std::vector<Eigen::Vector3f> values(on.size(), Eigen::Vector3f::Zero());
+  for (std::size_t texel = 0; texel < on.size(); ++texel) {
+    const TexelOnTriangle& p = on[texel];
+    if (p.corner < 0) continue;
+    const auto t = std::size_t(p.corner);
+    values[texel] = (1.f - p.u - p.v) * of[t] + p.u * of[t + 1] + p.v * of[t + 2];
+  }
+  return values;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model) {
+  return lerp_at_texels(model, model.positions);
+}
+
+std::vector<Eigen::Vector3f> texel_normals_from_uv(const SlfModel& model) {
+  std::vector<Eigen::Vector3f> normals = lerp_at_texels(model, model.normals);
+  for (Eigen::Vector3f& n : normals)
+    n = n.norm() > 1e-6f ? Eigen::Vector3f(n.normalized()) : Eigen::Vector3f::UnitY();
+  return normals;
 }
 
 }  // namespace render

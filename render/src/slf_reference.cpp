@@ -82,16 +82,35 @@ Eigen::Vector3f blend(const SlfModel& model, const Eigen::Vector2f& uv, const Ta
 
 }  // namespace slf_reference_taps
 
+namespace slf_reference_taps {
+
+// Texel `texel`'s taps toward the unit view `d` (from its point toward the viewer), mirrored
+// about its normal first when the grid holds reflected directions.
+SlfDirectionTaps texel_taps(const SlfModel& model, std::size_t texel, const Eigen::Vector3d& d) {
+  if (model.grid.space == prt::SlfDirectionSpace::kView) return slf_direction_taps(model.grid, d);
+  return slf_direction_taps(
+      model.grid, prt::slf_grid_space(model.grid, d, model.texel_normals[texel].cast<double>()));
+}
+
+}  // namespace slf_reference_taps
+
 Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
                              const Eigen::Vector3d& direction) {
-  const SlfDirectionTaps taps = slf_direction_taps(model.grid, direction);
-  return slf_reference_taps::blend(model, uv, [&](std::size_t) { return taps; });
+  if (model.grid.space == prt::SlfDirectionSpace::kView) {
+    const SlfDirectionTaps taps = slf_direction_taps(model.grid, direction);
+    return slf_reference_taps::blend(model, uv, [&](std::size_t) { return taps; });
+  }
+  const Eigen::Vector3d d = direction.normalized();
+  return slf_reference_taps::blend(model, uv, [&](std::size_t texel) {
+    return slf_reference_taps::texel_taps(model, texel, d);
+  });
 }
 
 Eigen::Vector3f slf_radiance_toward(const SlfModel& model, const Eigen::Vector2f& uv,
                                     const Eigen::Vector3d& eye) {
   return slf_reference_taps::blend(model, uv, [&](std::size_t texel) {
-    return slf_direction_taps(model.grid, eye - model.texel_positions[texel].cast<double>());
+    return slf_reference_taps::texel_taps(
+        model, texel, (eye - model.texel_positions[texel].cast<double>()).normalized());
   });
 }
 

@@ -20,7 +20,7 @@ namespace slf_gl {
 
 // Texture units, fixed in the shader's layout(binding) qualifiers.
 constexpr int kClusterUnit = 0, kViewsUnit = 1, kWeightsUnit = 2, kUvUnit = 3, kPositionsUnit = 4,
-              kRadianceUnit = 5;
+              kRadianceUnit = 5, kNormalsUnit = 6;
 // Texture-space shading works in square blocks of texels of this side (a multiple of
 // llvmpipe's 4 x 4 shading quads).
 constexpr int kBlock = 8;
@@ -137,12 +137,13 @@ std::string reconstruction_declarations(const SlfModel& model, const TileLayout&
   return s;
 }
 
-// From the direction `d` (toward the viewer) to `p`, its place in a view-map tile.
-std::string direction_to_tile(const std::string& indent) {
+// From the direction `d` (toward the viewer, or its mirror image) to `p`, its place in a
+// view-map tile.
+std::string direction_to_tile(const std::string& indent, const std::string& d = "d") {
   // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
-  return indent + "float azimuth = (d.x == 0.0 && d.z == 0.0) ? 0.0 : atan(d.x, -d.z);\n" + indent +
-         "vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(d.y, -1.0, 1.0)) * kInvPi);\n" +
-         indent + "vec2 p = vec2(1.0) + xi * kGridScale;\n";
+  return indent + "float azimuth = (" + d + ".x == 0.0 && " + d + ".z == 0.0) ? 0.0 : atan(" + d +
+         ".x, -" + d + ".z);\n" + indent + "vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(" +
+         d + ".y, -1.0, 1.0)) * kInvPi);\n" + indent + "vec2 p = vec2(1.0) + xi * kGridScale;\n";
 }
 
 // Adds to `l` cluster `t`'s reconstruction at `p` with the mean's coefficient `a0` and the
@@ -187,13 +188,20 @@ std::string view_sum(int k, const std::string& indent) {
 // both sides of a branch for its whole SIMD group, but leaves a loop as soon as no lane of
 // the group needs another iteration, so the common case pays for one reconstruction only.
 // Without `shared`, each iteration takes one texel (four iterations where all are used).
+// A grid of reflected directions takes one texel an iteration too: each texel mirrors the
+// fragment's direction about its own normal (the CPU reference's slf_radiance), so the four
+// have four places in the view maps.
 // Deferred: the atlas coordinate comes from the uv pre-pass's texture and the direction from
 // the pixel's ray (the CPU reference's Camera::pixel_direction, reversed).
 std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool shared,
                             bool deferred) {
   const int k = model.components, layers = (k + 3) / 4;
+  const bool reflected = model.grid.space == prt::SlfDirectionSpace::kReflected;
+  shared = shared && !reflected;
   std::string s = "#version 450 core\n";
   s += "layout(location = 0) out vec4 o_colour;\n";
+  if (reflected)
+    s += "layout(binding = " + std::to_string(kNormalsUnit) + ") uniform sampler2D u_normals;\n";
   if (deferred) {
     s += "layout(binding = " + std::to_string(kUvUnit) + ") uniform sampler2D u_uv;\n";
     s += "uniform vec3 u_forward, u_right, u_up;\nuniform vec2 u_pixel_scale;\n";
@@ -208,7 +216,7 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
          "  vec3 d = -normalize(u_forward + ndc.x * u_right + ndc.y * u_up);\n";
   else
     s += "  vec3 d = normalize(u_eye - v_world);\n";
-  s += direction_to_tile("  ");
+  if (!reflected) s += direction_to_tile("  ");
   s += "  vec2 st = v_uv * kMap - 0.5;\n"
        "  vec2 b = floor(st);\n"
        "  vec2 f = st - b;\n"
@@ -233,6 +241,12 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
   } else {
     s += "    vec4 take = left.x > 0.0 ? vec4(1, 0, 0, 0) : left.y > 0.0 ? vec4(0, 1, 0, 0)\n"
          "              : left.z > 0.0 ? vec4(0, 0, 1, 0) : left;\n";
+  }
+  if (reflected) {
+    s += "    ivec2 at = take.x > 0.0 ? lo : take.y > 0.0 ? ivec2(hi.x, lo.y)\n"
+         "             : take.z > 0.0 ? ivec2(lo.x, hi.y) : hi;\n"
+         "    vec3 r = reflect(-d, texelFetch(u_normals, at, 0).xyz);\n";
+    s += direction_to_tile("    ", "r");
   }
   s += "    left -= take;\n"
        "    vec4 m = take * w;\n"
@@ -268,15 +282,19 @@ std::string block_vertex_shader(const SlfModel& model) {
          "}\n";
 }
 
-// Texture space: the texel's own reconstruction toward the eye from its surface point,
-// unclamped (the clamp follows the spatial blend, in the mesh's pass). Unused texels are 0,
-// as the blend leaves them out. A loop of at most one iteration rather than an if, so that a
-// 4 x 4 group of unused texels skips the work (see fragment_shader).
+// Texture space: the texel's own reconstruction toward the eye from its surface point
+// (mirrored about the texel's normal for a grid of reflected directions), unclamped (the clamp
+// follows the spatial blend, in the mesh's pass). Unused texels are 0, as the blend leaves them
+// out. A loop of at most one iteration rather than an if, so that a 4 x 4 group of unused texels
+// skips the work (see fragment_shader).
 std::string texel_fragment_shader(const SlfModel& model, const TileLayout& tiles) {
   const int k = model.components, layers = (k + 3) / 4;
   std::string s = "#version 450 core\n";
   s += "layout(location = 0) out vec4 o_colour;\nuniform vec3 u_eye;\n";
   s += "layout(binding = " + std::to_string(kPositionsUnit) + ") uniform sampler2D u_positions;\n";
+  const bool reflected = model.grid.space == prt::SlfDirectionSpace::kReflected;
+  if (reflected)
+    s += "layout(binding = " + std::to_string(kNormalsUnit) + ") uniform sampler2D u_normals;\n";
   s += reconstruction_declarations(model, tiles);
   s += "void main() {\n"
        "  ivec2 texel = ivec2(gl_FragCoord.xy);\n"
@@ -284,6 +302,7 @@ std::string texel_fragment_shader(const SlfModel& model, const TileLayout& tiles
        "  vec3 l = vec3(0.0);\n"
        "  for (int once = t >= 0 ? 1 : 0; once > 0; --once) {\n"
        "    vec3 d = normalize(u_eye - texelFetch(u_positions, texel, 0).xyz);\n";
+  if (reflected) s += "    d = reflect(-d, texelFetch(u_normals, texel, 0).xyz);\n";
   s += direction_to_tile("    ");
   s += "    float a0 = 1.0;\n";
   for (int l = 0; l < layers; ++l)
@@ -475,6 +494,7 @@ struct SlfRenderer::Impl {
   GLsizei vertex_count = 0;
   // Texture space: texel points, the radiance map and its framebuffer, the block instances.
   GLuint positions_texture = 0, radiance_texture = 0, radiance_fbo = 0;
+  GLuint normals_texture = 0;  // reflected directions: each texel's normal
   GLuint block_vao = 0, block_vbo = 0;
   std::vector<slf_gl::TexelBlock> blocks;
   std::vector<std::int32_t> visible_blocks;
@@ -606,6 +626,14 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
   glBindTexture(GL_TEXTURE_2D, positions_texture);
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, x_size, y_size, 0, GL_RGBA, GL_FLOAT, points.data());
   slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
+  if (model.grid.space == prt::SlfDirectionSpace::kReflected) {
+    for (std::size_t t = 0; t < texels; ++t)
+      for (int i = 0; i < 3; ++i) points[t * 4 + std::size_t(i)] = model.texel_normals[t][i];
+    glGenTextures(1, &normals_texture);
+    glBindTexture(GL_TEXTURE_2D, normals_texture);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, x_size, y_size, 0, GL_RGBA, GL_FLOAT, points.data());
+    slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
+  }
   std::fill(points.begin(), points.end(), 0.f);
   glGenTextures(1, &radiance_texture);
   glBindTexture(GL_TEXTURE_2D, radiance_texture);
@@ -673,6 +701,7 @@ SlfRenderer::Impl::~Impl() {
   if (weights_texture) glDeleteTextures(1, &weights_texture);
   if (uv_texture) glDeleteTextures(1, &uv_texture);
   glDeleteTextures(1, &positions_texture);
+  if (normals_texture) glDeleteTextures(1, &normals_texture);
   glDeleteTextures(1, &radiance_texture);
   glDeleteFramebuffers(1, &radiance_fbo);
   glDeleteBuffers(1, &block_vbo);
@@ -688,6 +717,10 @@ void SlfRenderer::Impl::bind_textures() {
   if (weights_texture) {
     glActiveTexture(GL_TEXTURE0 + slf_gl::kWeightsUnit);
     glBindTexture(GL_TEXTURE_2D_ARRAY, weights_texture);
+  }
+  if (normals_texture) {
+    glActiveTexture(GL_TEXTURE0 + slf_gl::kNormalsUnit);
+    glBindTexture(GL_TEXTURE_2D, normals_texture);
   }
   glActiveTexture(GL_TEXTURE0);
 }

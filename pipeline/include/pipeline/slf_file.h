@@ -16,7 +16,8 @@
 //   0 magic "PRTRSLFC", 8 u32 version, 12 u32 header bytes (128),
 //   16 u16 atlas width, 18 u16 atlas charts (meshes::AtlasCharts), 20 u32 atlas height,
 //   24 u32 Z, 28 u32 W, 32 u32 spp, 36 u16 bounces, 38 u16 light samples,
-//   40 u32 material kind, 44 u32 masking, 48 u64 rows of the whole matrix (owned texels),
+//   40 u32 material kind, 44 u16 masking, 46 u16 direction space (prt::SlfDirectionSpace),
+//   48 u64 rows of the whole matrix (owned texels),
 //   56 u64 mesh content hash, 64 f32[3] albedo, 76 f32 specular, 80 f32 exponent,
 //   84 f32 roughness, 88 f32 f0, 92 u32 clusters K, 96 u32 components N,
 //   100 u16 mesh path bytes, 102 u16 probe name bytes, 104 u64 FNV-1a of everything after
@@ -28,7 +29,8 @@
 // f32[K N D] with D = 3 Z W; then nothing. A file normally stores every row (first row 0,
 // V = rows); one made from a row range (a measurement) says so and the renderer refuses it.
 // Version 1 (still read) had a u32 atlas width at 16 and always per-triangle charts;
-// versions 1 and 2 a u32 bounces at 36 and no shared light samples (read as 0).
+// versions 1 and 2 a u32 bounces at 36 and no shared light samples (read as 0); versions 1
+// to 3 a u32 masking at 44 and view directions only.
 #pragma once
 
 #include "cpca/compressed.h"
@@ -40,7 +42,7 @@
 
 namespace pipeline {
 
-inline constexpr std::uint32_t kSlfcFileVersion = 3;
+inline constexpr std::uint32_t kSlfcFileVersion = 4;
 inline constexpr std::size_t kMaxSlfcNameBytes = 4096;
 
 class SlfcFileError : public std::runtime_error {

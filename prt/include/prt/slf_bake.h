@@ -22,8 +22,8 @@
 //   0 magic "PRTRSLFM", 8 u32 version, 12 u32 header bytes (128),
 //   16 u16 atlas width, 18 u16 atlas charts (meshes::AtlasCharts), 20 u32 atlas height,
 //   24 u32 Z (azimuth cells), 28 u32 W (polar cells),
-//   32 u32 spp, 36 u16 bounces, 38 u16 light samples, 40 u32 material kind, 44 u32 masking,
-//   48 u64 seed,
+//   32 u32 spp, 36 u16 bounces, 38 u16 light samples, 40 u32 material kind, 44 u16 masking,
+//   46 u16 direction space (prt::SlfDirectionSpace), 48 u64 seed,
 //   56 u64 mesh content hash, 64 f32[3] albedo, 76 f32 specular, 80 f32 exponent,
 //   84 f32 roughness, 88 f32 f0, 92 u32 rows of the whole matrix, 96 u32 first row stored,
 //   100 u32 rows stored, 104 u64 FNV-1a of the payload, 112 u64 FNV-1a of the probe's texels,
@@ -31,6 +31,7 @@
 // then rows stored x 3 Z W float32, then nothing. Version 1 (still read) had a u32 atlas
 // width at 16 and always per-triangle charts; its widths (at most 8192) left bytes 18-19 zero.
 // Versions 1 and 2 had a u32 bounces at 36 and no shared light samples: they read as 0.
+// Versions 1 to 3 had a u32 masking at 44 and view directions only.
 #pragma once
 
 #include "common/binary_file.h"
@@ -49,7 +50,7 @@
 
 namespace prt {
 
-inline constexpr std::uint32_t kSlfFileVersion = 3;
+inline constexpr std::uint32_t kSlfFileVersion = 4;
 inline constexpr int kMaxLightSamples = 4096;  // SlfBakeOptions::light_samples
 
 class SlfFileError : public std::runtime_error {
@@ -107,11 +108,13 @@ struct SlfMatrix {
 // 56-91 (mesh hash, albedo, specular, exponent, roughness, f0) and 112 (probe hash). Reading
 // clamps counts to 2^30 so a hostile header cannot overflow an int; the caller validates
 // (slf_settings_problem). A version 1 header (both files) reads as per-triangle charts, a
-// version 1 or 2 header as no shared light samples.
+// version 1 or 2 header as no shared light samples, a version 1 to 3 header as view
+// directions (masking a u32 at 44 there, a u16 beside the direction space from version 4).
 void put_slf_settings(common::VersionedHeader& header, const SlfShape& shape);
 void get_slf_settings(const common::VersionedHeader& header, SlfShape& shape);
-// Empty when the chart method is one make_atlas knows; else the problem, naming it.
-std::string slf_charts_problem(const SlfShape& shape);
+// Empty when the chart method is one make_atlas knows and the direction space one the
+// renderer knows; else the problem, naming it.
+std::string slf_layout_problem(const SlfShape& shape);
 
 // The owned texels of the atlas in texel order: row r of the SLF matrix samples texel
 // slf_rows(atlas)[r] (y * width + x).

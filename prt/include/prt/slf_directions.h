@@ -12,15 +12,33 @@
 // Direction (i, j), azimuth cell i in [0, Z) and polar cell j in [0, W), sits at its cell's
 // centre, xi1 = 2 (i + 0.5) / Z and xi2 = (j + 0.5) / W, and is column j Z + i of a row of
 // the SLF matrix (times three: RGB innermost, as render/slf_model.h lays out the view maps).
+//
+// The grid's directions are either the views themselves (the paper's) or their mirror images
+// about the point's shading normal n, r = 2 (n . v) n - v: the reflected reparameterisation
+// of Wood et al. (Surface Light Fields for 3D Photography, SIGGRAPH 2000). A glossy lobe
+// and the probe's features it reflects then sit at the same grid place for every point, and
+// a view's angle to the normal maps to the same angle, so a rim lit from behind changes
+// along the polar axis at half the angular rate. Reflection is its own inverse and keeps
+// solid angle, so a cell's mean over r is its mean over the views it maps to.
 #pragma once
+
+#include "common/enum_names.h"
 
 #include <Eigen/Core>
 
+#include <cstdint>
+
 namespace prt {
+
+enum class SlfDirectionSpace : std::uint16_t { kView = 0, kReflected = 1 };
+inline constexpr auto kSlfDirectionSpaceNames = common::enum_table<SlfDirectionSpace>(
+    "direction space",
+    {{SlfDirectionSpace::kView, "view"}, {SlfDirectionSpace::kReflected, "reflected"}});
 
 struct SlfGrid {
   int azimuth = 32;    // Z
   int elevation = 16;  // W
+  SlfDirectionSpace space = SlfDirectionSpace::kView;
   int directions() const { return azimuth * elevation; }
   void validate() const;  // both in [1, 4096]; std::invalid_argument naming the bad one
 };
@@ -31,5 +49,11 @@ Eigen::Vector3d slf_direction(double xi1, double xi2);
 Eigen::Vector2d slf_coordinates(const Eigen::Vector3d& direction);
 // The centre of column j Z + i.
 Eigen::Vector3d slf_grid_direction(const SlfGrid& grid, int column);
+
+// Where a unit view (from the point toward the viewer) sits on the grid, at a point of unit
+// shading normal `normal`: the view itself, or its reflection. Its own inverse: it also
+// turns a grid direction into the view it stands for.
+Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
+                               const Eigen::Vector3d& normal);
 
 }  // namespace prt

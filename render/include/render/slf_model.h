@@ -37,6 +37,10 @@ struct SlfModel {
   // triangle); any finite value where the cluster is -1. Texture-space shading takes a
   // texel's view direction from it, as the paper does per texel.
   std::vector<Eigen::Vector3f> texel_positions;
+  // X Y unit shading normals (meshes::texel_normals), where the grid holds reflected
+  // directions (prt/slf_directions.h): each texel mirrors its view about its own normal
+  // before the grid lookup, as its bake did. Empty for view directions.
+  std::vector<Eigen::Vector3f> texel_normals;
   // clusters (k + 1) Z W 3: cluster, slice (0 the mean, 1 + j component j), direction
   // column j Z + i, then RGB. The view maps V.
   std::vector<float> view_maps;
@@ -54,5 +58,7 @@ struct SlfModel {
 // nearest in uv, barycentrics clamped onto it (the atlas's gutter rule, charts aside).
 // Needs the geometry, uv, map size and texel_cluster; other texels get (0, 0, 0).
 std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model);
+// The same texels' unit normals, from the corners' normals (the face's where they cancel).
+std::vector<Eigen::Vector3f> texel_normals_from_uv(const SlfModel& model);
 
 }  // namespace render

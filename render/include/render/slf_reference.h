@@ -18,6 +18,8 @@
 //  - Every texel uses the fragment's own direction (slf_radiance), or, as the paper does, its
 //    own: from the texel's surface point toward the eye (slf_radiance_toward, what
 //    texture-space shading computes). The two differ by the angle a texel subtends at the eye.
+//  - A grid of reflected directions (prt/slf_directions.h) mirrors each texel's direction
+//    about that texel's normal (SlfModel::texel_normals) before the lookup, in both forms.
 //  - Negative radiance is clamped to 0 per channel once, after the spatial blend: CPCA's
 //    reconstruction of a noisy matrix undershoots where the data is near zero (a silhouette
 //    whose red and green go below zero shows as blue dots). Clamping each texel before the

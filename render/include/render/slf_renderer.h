@@ -42,6 +42,10 @@
 // more than the fragments the last frame's mesh shaded (a sample query; before the first
 // frame, the frame's pixels), and otherwise on the screen: deferred on a software rasterizer,
 // one pass on a GPU.
+// A grid of reflected directions (prt/slf_directions.h) mirrors each texel's view about
+// that texel's own normal (an RGBA32F normal map beside the weights), so the four texels of
+// a fragment have four places in the view maps: the screen paths then reconstruct them one
+// at a time (no shared-cluster sum), and texture space mirrors each texel's own direction.
 //
 // Precision: on Mesa's rasterisers the filter weights are single floats; a hardware GPU's
 // texture units may quantise them (8 fractional bits on many), which rounds the
