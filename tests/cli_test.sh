@@ -361,6 +361,7 @@ if [[ -f $forest ]]; then
   awk -v r="$rows" -v c="$cols" -v k="$k" -v n="$pcs" -v q="$ratio" 'BEGIN { e = r * c / (r * n + k * (n + 1) * c); exit !(c == 96 && k == 4 && n == 2 && r > 0 && q > 1 && (q - e) ^ 2 < 1e-12) }'
   check "info --json: a .slfc's rows $rows x $cols, K $k, N $pcs, ratio $ratio" $?
   [[ $spp == 2 && $(jget - /probe /format <<<"$out" | tr '\n' ' ') == "forest.exr slfc " ]]; check "info --json: a .slfc's spp, probe and format" $?
+  [[ $(jget - /direction_space <<<"$out") == reflected ]]; check "info --json: a .slfc's grid holds reflected directions by default" $?
   run info "$tmp/cube.slfc" --mesh "$tmp/quad.obj"; expect_code 1 && [[ $out == *STALE* ]]; check "info: a .slfc stale against another mesh exits 1" $?
   run slf "$tmp/cube.obj" --probe "$forest" --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/cached.slfc" --cache "$tmp/slf_cache" -q
   slfs=("$tmp"/slf_cache/slf-*.slf)
@@ -380,6 +381,10 @@ if [[ -f $forest ]]; then
   expect_code 0 && [[ $(jget - /atlas_charts <<<"$out") == per-triangle ]]; check "info: a per-triangle .slfc says so" $?
   run render "$tmp/tri.slfc" --probe "$forest" --width 16 --height 12 --frames 1 --warmup 0 -o "$tmp/tri.exr" -q
   expect_code 0 && [[ -s $tmp/tri.exr ]]; check "render: a per-triangle .slfc renders with its own atlas ($err)" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --direction-space view --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/view.slfc" --no-cache --json -q
+  expect_code 0 && [[ $(jget - /direction_space <<<"$out") == view ]]; check "slf --direction-space view: the paper's grid, reported ($err)" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --direction-space sideways -o "$tmp/x.slfc" --no-cache -q
+  expect_code 2 && [[ $err == *--direction-space* ]]; check "slf: an unknown --direction-space is a usage error naming it" $?
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 -o "$tmp/pt.exr" -q
   expect_code 0 && [[ -s $tmp/pt.exr ]]; check "path-trace writes an EXR" $?
   # prtr render shows the .slfc in one pass; PRT's lighting flags and another probe are refused.

@@ -250,6 +250,7 @@ void slf_shape_json(Json& j, const prt::SlfShape& b) {
   j["directions_azimuth"] = b.grid.azimuth;
   j["directions_polar"] = b.grid.elevation;
   j["directions"] = b.grid.directions();
+  j["direction_space"] = prt::kSlfDirectionSpaceNames.name(b.grid.space);
   j["columns"] = b.columns();
   j["rows"] = b.rows;
   j["first_row"] = b.first_row;
@@ -267,8 +268,10 @@ void print_slf_shape(const prt::SlfShape& b) {
   std::printf("atlas       %d x %d texels, %s charts, %llu owned (the rows)\n", b.atlas_width,
               b.atlas_height, std::string(meshes::kAtlasChartsNames.name(b.charts)).c_str(),
               u(b.rows));
-  std::printf("directions  %d x %d (azimuth x polar): %d, x 3 channels = %llu floats per row\n",
-              b.grid.azimuth, b.grid.elevation, b.grid.directions(), u(b.columns()));
+  std::printf("directions  %d x %d (azimuth x polar) %s: %d, x 3 channels = %llu floats per row\n",
+              b.grid.azimuth, b.grid.elevation,
+              b.grid.space == prt::SlfDirectionSpace::kView ? "views" : "reflected views",
+              b.grid.directions(), u(b.columns()));
   if (b.first_row == 0 && b.row_count == b.rows)
     std::printf("rows        %llu, all of the matrix\n", u(b.row_count));
   else

@@ -190,6 +190,7 @@ void run(const Options& o, CLI::App*) {
     j["atlas_rows"] = r.slf.bake.rows;
     j["atlas_charts"] = meshes::kAtlasChartsNames.name(r.slf.bake.charts);
     j["directions"] = r.slf.bake.grid.directions();
+    j["direction_space"] = prt::kSlfDirectionSpaceNames.name(r.slf.bake.grid.space);
     j["data_generation_seconds"] = r.bake_seconds;
     j["bake_cached"] = r.bake_cached;
     j["compression_seconds"] = r.compress_seconds;
@@ -201,9 +202,10 @@ void run(const Options& o, CLI::App*) {
     return;
   }
   std::printf("wrote %s (%s)\n", o.output.c_str(), format_bytes(file_bytes).c_str());
-  std::printf("rows (texels)      %llu of %llu, x %d directions x 3 channels\n",
+  std::printf("rows (texels)      %llu of %llu, x %d %sdirections x 3 channels\n",
               static_cast<unsigned long long>(r.slf.bake.row_count),
-              static_cast<unsigned long long>(r.slf.bake.rows), r.slf.bake.grid.directions());
+              static_cast<unsigned long long>(r.slf.bake.rows), r.slf.bake.grid.directions(),
+              r.slf.bake.grid.space == prt::SlfDirectionSpace::kReflected ? "reflected " : "");
   std::printf("data generation    %.2f s%s\n", r.bake_seconds,
               r.bake_cached ? " (read from the cache; the bake itself was earlier)" : "");
   std::printf("compression        %.2f s (K = %d clusters, N = %d components)\n",

@@ -39,6 +39,13 @@ void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
                   "sphere (64x32, the SLF paper's glossy grid, sharpens glints at 4x the bake "
                   "with the same --spp)")
       ->capture_default_str();
+  cmd->add_option("--direction-space", f.direction_space,
+                  "Surface light field: what the direction grid holds: the views (the SLF "
+                  "paper's) or their mirror images about the shading normal (reflected, Wood et "
+                  "al. 2000: a glossy lobe and what it reflects sit at one grid place across the "
+                  "surface)")
+      ->check(CLI::IsMember(prt::kSlfDirectionSpaceNames.names()))
+      ->capture_default_str();
   add_checked_option(cmd, "--spp", f.spp,
                      "Surface light field: path-traced samples per texel and direction cell",
                      integer_in(1, 65536));
@@ -60,6 +67,7 @@ void resolve_slf_flags(const SlfFlags& f, pipeline::SlfSettings& settings) {
   settings.charts = meshes::kAtlasChartsNames.parse(f.charts);
   std::tie(settings.bake.grid.azimuth, settings.bake.grid.elevation) =
       parse_size(f.directions, "--directions", 1, 4096);
+  settings.bake.grid.space = prt::kSlfDirectionSpaceNames.parse(f.direction_space);
   settings.bake.spp = f.spp;
   settings.bake.light_samples = f.light_samples;
   settings.filter.radius = f.texel_filter;
