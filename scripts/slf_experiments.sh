@@ -3,7 +3,7 @@
 # fields against a path-traced reference"): an icosphere (642 vertices, written here) in
 # Cook-Torrance m 0.1 (specular 0.5, albedo 0.3) under the forest probe, seen by prtr's
 # default camera at 320 x 240. Rows: prtr slf (256 x 256 texels, 32 x 16 directions, 16 paths
-# a cell, K 256, k 8) shown by prtr render; PRT orders 6 and 10 (K 64, 8 PCs); a second
+# a cell, reflected directions, K 256, k 8) shown by prtr render; PRT orders 6 and 10 (K 64, 8 PCs); a second
 # 256-path reference (the reference's own noise). Each judged by prtr compare against a
 # 4096-path prtr path-trace, over every covered pixel and over those 2 and 5 pixels inside
 # the outline (prtr compare --erode: the grazing rim left out). Writes OUT_DIR/table.md and OUT_DIR/side_by_side.png
