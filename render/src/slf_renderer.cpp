@@ -620,20 +620,17 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
   // Texture space: each texel's surface point, and the radiance map it shades into (zero
   // until a frame writes it; texels never written are read with weight 0 or not at all).
   std::vector<float> points(texels * 4, 0.f);
-  for (std::size_t t = 0; t < texels; ++t)
-    for (int i = 0; i < 3; ++i) points[t * 4 + std::size_t(i)] = model.texel_positions[t][i];
-  glGenTextures(1, &positions_texture);
-  glBindTexture(GL_TEXTURE_2D, positions_texture);
-  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, x_size, y_size, 0, GL_RGBA, GL_FLOAT, points.data());
-  slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
-  if (model.grid.space == prt::SlfDirectionSpace::kReflected) {
+  const auto upload = [&](const std::vector<Eigen::Vector3f>& per_texel, GLuint& texture) {
     for (std::size_t t = 0; t < texels; ++t)
-      for (int i = 0; i < 3; ++i) points[t * 4 + std::size_t(i)] = model.texel_normals[t][i];
-    glGenTextures(1, &normals_texture);
-    glBindTexture(GL_TEXTURE_2D, normals_texture);
+      for (int i = 0; i < 3; ++i) points[t * 4 + std::size_t(i)] = per_texel[t][i];
+    glGenTextures(1, &texture);
+    glBindTexture(GL_TEXTURE_2D, texture);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, x_size, y_size, 0, GL_RGBA, GL_FLOAT, points.data());
     slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
-  }
+  };
+  upload(model.texel_positions, positions_texture);
+  if (model.grid.space == prt::SlfDirectionSpace::kReflected)
+    upload(model.texel_normals, normals_texture);
   std::fill(points.begin(), points.end(), 0.f);
   glGenTextures(1, &radiance_texture);
   glBindTexture(GL_TEXTURE_2D, radiance_texture);
