@@ -267,6 +267,53 @@ TEST(SlfBake, TheFileRecordsTheDirectionSpace) {
   EXPECT_EQ(v3.shape.material.masking, prt::Masking::kVGroove);
 }
 
+// On a plane facing +Y, the mirror image about the normal of a direction at lat-long cell
+// (i, j) is the direction half a turn around the pole, in cell (i + Z/2, j): the reflected
+// bake must hold, cell for cell, what the view bake holds half a turn away (differing by no
+// more than two view bakes of different seeds do), and differ from the view bake at the
+// same cell under a probe that is brighter toward +X.
+TEST(SlfBake, AReflectedGridHoldsTheMirroredViewsRadiance) {
+  const meshes::Mesh plane = meshes::make_plane(2.f, 1);
+  const meshes::Atlas atlas = meshes::make_atlas(plane, 8, 8);
+  const probes::Probe probe = probes::make_from_function(64, 32, [](const Eigen::Vector3d& d) {
+    const float v = float(1.0 + 0.8 * d.x() + 0.3 * d.y());
+    return probes::Rgb(v, 0.5f * v, 0.25f);
+  });
+  prt::SlfBakeOptions o;
+  o.grid = {8, 4};
+  o.spp = 128;
+  o.bounces = 0;
+  o.material.kind = prt::MaterialKind::kPhong;
+  o.material.exponent = 8;
+  o.material.specular = 0.6f;
+  o.material.albedo = Eigen::Vector3f::Constant(0.2f);
+  const prt::SlfMatrix view = prt::bake_slf(plane, atlas, probe, o);
+  o.grid.space = prt::SlfDirectionSpace::kReflected;
+  o.seed = 2;
+  const prt::SlfMatrix mirrored = prt::bake_slf(plane, atlas, probe, o);
+  ASSERT_EQ(view.data.size(), mirrored.data.size());
+  double shifted = 0, same = 0;
+  const int z = o.grid.azimuth;
+  for (std::uint64_t r = 0; r < view.shape.row_count; ++r)
+    for (int j = 0; j < o.grid.elevation; ++j)
+      for (int i = 0; i < z; ++i)
+        for (int c = 0; c < 3; ++c) {
+          const double m = mirrored.row(r)[3 * (j * z + i) + c];
+          const double v_half = view.row(r)[3 * (j * z + (i + z / 2) % z) + c];
+          const double v_same = view.row(r)[3 * (j * z + i) + c];
+          shifted += (m - v_half) * (m - v_half);
+          same += (m - v_same) * (m - v_same);
+        }
+  // The two bakes' noise: the view bake again with the reflected one's seed.
+  o.grid.space = prt::SlfDirectionSpace::kView;
+  const prt::SlfMatrix view_again = prt::bake_slf(plane, atlas, probe, o);
+  double noise = 0;
+  for (std::size_t k = 0; k < view.data.size(); ++k)
+    noise += double(view.data[k] - view_again.data[k]) * double(view.data[k] - view_again.data[k]);
+  EXPECT_LT(std::sqrt(shifted / noise), 1.2);
+  EXPECT_GT(std::sqrt(same / noise), 4.0);
+}
+
 // Reflection about the normal is its own inverse and keeps the angle to the normal, so a
 // cell's views are as far from the horizon as the cell; a grid of views is the identity.
 TEST(SlfDirections, ReflectedSpaceMirrorsAboutTheNormal) {
