@@ -178,6 +178,12 @@ TEST(SlfBake, FileHoldsTheBakeAndPartsJoinToIt) {
   EXPECT_EQ(joined.shape.row_count, whole.shape.rows);
   test_support::error_of<prt::SlfFileError>(
       second, [&](const fs::path& p) { prt::join_slf_parts({p}); }, "starts at row");
+  // A part of the other direction space is another matrix.
+  o.grid.space = prt::SlfDirectionSpace::kReflected;
+  const fs::path mirrored = scratch("slf_bake", "part0_reflected.slf");
+  prt::bake_slf_to_file(s.mesh, s.atlas, s.sky, o, mirrored);
+  test_support::error_of<prt::SlfFileError>(
+      second, [&](const fs::path& p) { prt::join_slf_parts({mirrored, p}); }, "other settings");
 
   o.end_row = whole.shape.rows + 1;
   EXPECT_THROW(prt::bake_slf(s.mesh, s.atlas, s.sky, o), std::invalid_argument);

@@ -529,11 +529,11 @@ SlfMatrix join_slf_parts(const std::vector<fs::path>& parts) {
     const SlfShape& w = whole.shape;
     if (s.atlas_width != w.atlas_width || s.atlas_height != w.atlas_height ||
         s.charts != w.charts || s.grid.azimuth != w.grid.azimuth ||
-        s.grid.elevation != w.grid.elevation || s.spp != w.spp || s.bounces != w.bounces ||
-        s.light_samples != w.light_samples || s.seed != w.seed || s.mesh_hash != w.mesh_hash ||
-        s.probe_hash != w.probe_hash || s.rows != w.rows || s.material.kind != w.material.kind ||
-        s.material.albedo != w.material.albedo || s.material.specular != w.material.specular ||
-        s.material.exponent != w.material.exponent ||
+        s.grid.elevation != w.grid.elevation || s.grid.space != w.grid.space || s.spp != w.spp ||
+        s.bounces != w.bounces || s.light_samples != w.light_samples || s.seed != w.seed ||
+        s.mesh_hash != w.mesh_hash || s.probe_hash != w.probe_hash || s.rows != w.rows ||
+        s.material.kind != w.material.kind || s.material.albedo != w.material.albedo ||
+        s.material.specular != w.material.specular || s.material.exponent != w.material.exponent ||
         s.material.roughness != w.material.roughness || s.material.f0 != w.material.f0 ||
         s.material.masking != w.material.masking) {
       throw SlfFileError(parts[i].string() + ": baked with other settings than " +
