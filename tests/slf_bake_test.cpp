@@ -183,7 +183,11 @@ TEST(SlfBake, FileHoldsTheBakeAndPartsJoinToIt) {
   const fs::path mirrored = scratch("slf_bake", "part0_reflected.slf");
   prt::bake_slf_to_file(s.mesh, s.atlas, s.sky, o, mirrored);
   test_support::error_of<prt::SlfFileError>(
-      second, [&](const fs::path& p) { prt::join_slf_parts({mirrored, p}); }, "other settings");
+      second,
+      [&](const fs::path& p) {
+        prt::join_slf_parts({mirrored, p});
+      },
+      "other settings");
 
   o.end_row = whole.shape.rows + 1;
   EXPECT_THROW(prt::bake_slf(s.mesh, s.atlas, s.sky, o), std::invalid_argument);

@@ -1,8 +1,8 @@
 // apps/prtr/slf_flags.h: the surface light field's sampling flags (the atlas size, --charts,
 // --directions, --direction-space, --spp, --light-samples), registered with one help text and one
 // set of defaults by the commands that make an SLF: prtr slf (atlas size as --samples) and prtr
-// relight --kind slf (as
-// --slf-samples, since its --samples is the PRT bake's directions per vertex).
+// relight --kind slf (as --slf-samples, since its --samples is the PRT bake's directions per
+// vertex).
 #pragma once
 
 #include "meshes/atlas.h"
@@ -16,11 +16,11 @@ namespace prtr_app {
 
 struct SlfFlags {
   std::string samples = "256x256", directions = "32x16",
-              charts = std::string(meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal)),
-              // Reflected rather than the paper's views: lower image error on every mesh and
-              // probe measured (docs/BENCHMARKS.md, "Reflected directions").
-      direction_space =
-          std::string(prt::kSlfDirectionSpaceNames.name(prt::SlfDirectionSpace::kReflected));
+              charts = std::string(meshes::kAtlasChartsNames.name(meshes::AtlasCharts::kConformal));
+  // Reflected rather than the paper's views: lower image error on every mesh and probe
+  // measured (docs/BENCHMARKS.md, "Reflected directions").
+  std::string direction_space =
+      std::string(prt::kSlfDirectionSpaceNames.name(prt::SlfDirectionSpace::kReflected));
   int spp = 16;
   int light_samples = prt::SlfBakeOptions{}.light_samples;
   int texel_filter = prt::SlfFilterOptions{}.radius;

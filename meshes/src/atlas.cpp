@@ -241,14 +241,14 @@ std::vector<Eigen::Vector3f> texel_points(const Mesh& mesh, const Atlas& atlas) 
 std::vector<Eigen::Vector3f> texel_normals(const Mesh& mesh, const Atlas& atlas) {
   return per_texel(
       mesh, atlas, "texel normals", [&](const Triangle& tri, const Eigen::Vector2f& b) {
+        if (mesh.has_frames()) {
+          const Eigen::Vector3f n = (1.f - b.x() - b.y()) * mesh.normals[tri[0]] +
+                                    b.x() * mesh.normals[tri[1]] + b.y() * mesh.normals[tri[2]];
+          if (n.norm() > 1e-6f) return Eigen::Vector3f(n.normalized());
+        }
         const Eigen::Vector3f face = (mesh.positions[tri[1]] - mesh.positions[tri[0]])
                                          .cross(mesh.positions[tri[2]] - mesh.positions[tri[0]]);
-        const Eigen::Vector3f face_unit =
-            face.norm() > 0.f ? Eigen::Vector3f(face.normalized()) : Eigen::Vector3f::UnitY();
-        if (!mesh.has_frames()) return face_unit;
-        const Eigen::Vector3f n = (1.f - b.x() - b.y()) * mesh.normals[tri[0]] +
-                                  b.x() * mesh.normals[tri[1]] + b.y() * mesh.normals[tri[2]];
-        return n.norm() > 1e-6f ? Eigen::Vector3f(n.normalized()) : face_unit;
+        return face.norm() > 0.f ? Eigen::Vector3f(face.normalized()) : Eigen::Vector3f::UnitY();
       });
 }
 

@@ -93,8 +93,9 @@ void SlfModel::validate() const {
                                  "one per texel (map_width x map_height) for reflected directions");
     for (std::size_t t = 0; t < texels; ++t)
       if (texel_cluster[t] >= 0 && !(std::abs(texel_normals[t].squaredNorm() - 1.f) < 1e-3f))
-        slf_model_checks::refuse("texel_normals[" + std::to_string(t) +
-                                 "] is not a unit vector; rebuild the model from finite data");
+        slf_model_checks::refuse(
+            "texel_normals[" + std::to_string(t) +
+            "] is not a unit vector; take the normals from meshes::texel_normals");
   } else if (!texel_normals.empty()) {
     slf_model_checks::refuse(
         "texel_normals is given for a grid of view directions; only "

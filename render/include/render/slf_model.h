@@ -58,7 +58,8 @@ struct SlfModel {
 // nearest in uv, barycentrics clamped onto it (the atlas's gutter rule, charts aside).
 // Needs the geometry, uv, map size and texel_cluster; other texels get (0, 0, 0).
 std::vector<Eigen::Vector3f> texel_points_from_uv(const SlfModel& model);
-// The same texels' unit normals, from the corners' normals (the face's where they cancel).
+// The same texels' unit normals, from the corners' normals (+Y where they cancel and where
+// no triangle reads the texel).
 std::vector<Eigen::Vector3f> texel_normals_from_uv(const SlfModel& model);
 
 }  // namespace render
