@@ -47,6 +47,8 @@ def check_loopback(server):
     check("info: 4 clusters, k = 2, 8 x 4 = 32 directions",
           (info.get("clusters"), info.get("components"), info.get("directions")) == (4, 2, 32),
           str(info))
+    check("info: the default direction space, reflected",
+          info.get("direction_space") == "reflected", str(info))
     check("info: texels in the 64 x 64 atlas",
           0 < info.get("texels", 0) <= 64 * 64 and info.get("atlas_width") == 64, str(info))
     check("info: only the baked probe", info.get("probes") == ["a_sky.hdr"], str(info))
@@ -87,7 +89,7 @@ def check_page(browser, server, tmp):
     about = text(browser, "about")
     check("about: a surface light field with its k, clusters, texels and directions",
           "surface light field" in about and "k = 2" in about and "4 clusters" in about and
-          "texels" in about and "32 directions" in about, about)
+          "texels" in about and "32 reflected directions" in about, about)
     check("about box shown", browser.evaluate(
         "document.getElementById('about').offsetParent !== null"))
     for control in ["drag-env", "autorotate", "probe", "mode", "strategy", "budget", "cpp",

@@ -16,6 +16,7 @@
 #include "probes/load.h"
 #include "progress_bar.h"
 #include "prt/sh.h"
+#include "prt/slf_directions.h"
 #include "slf_input.h"
 #include "supersample_flag.h"
 #include "view_flags.h"
@@ -184,6 +185,7 @@ const std::set<std::string>& slf_flags() {
 Json slf_info_json(const Options& o, const SlfInput& in, const SceneInfo& scene,
                    const ViewState& d) {
   const pipeline::CompressedSlf& slf = in.slf;
+  const std::string space(prt::kSlfDirectionSpaceNames.name(slf.bake.grid.space));
   return Json{{"kind", "slf"},
               {"slfc", fs::path(o.mesh).filename().string()},
               {"mesh", fs::path(in.mesh_path).filename().string()},
@@ -197,6 +199,7 @@ Json slf_info_json(const Options& o, const SlfInput& in, const SceneInfo& scene,
               {"directions", slf.bake.grid.directions()},
               {"azimuth", slf.bake.grid.azimuth},
               {"elevation", slf.bake.grid.elevation},
+              {"direction_space", space},
               {"probe_name", slf.probe_name},
               {"probes", Json::array({fs::path(o.probe).filename().string()})},
               {"gl_renderer", scene.gl_renderer},

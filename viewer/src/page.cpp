@@ -390,7 +390,8 @@ function startSlf(info) {
   $("about").textContent = "surface light field " + info.slfc + " of " + info.mesh + ": k = " +
       info.components + " PCA terms, " + info.clusters + " clusters, " + info.texels +
       " texels (" + info.atlas_width + " × " + info.atlas_height + " atlas), " +
-      info.directions + " directions (" + info.azimuth + " × " + info.elevation + ")";
+      info.directions + " " + info.direction_space + " directions (" + info.azimuth + " × " +
+      info.elevation + ")";
   $("slf-probe").textContent = info.probe_name;
   $("stat-clusters").textContent = String(info.clusters);
   $("stat-pcs").textContent = String(info.components);
