@@ -347,6 +347,103 @@ TEST(SlfDirections, ReflectedSpaceMirrorsAboutTheNormal) {
   EXPECT_LT((prt::slf_grid_space(reflected, n, n) - n).norm(), 1e-15);
 }
 
+// The local grid's frame, written out independently: the pole the normal, azimuth 0 the
+// world's up projected onto the tangent plane; polar over [0, pi / 2], the horizon's row for
+// views below it; an exact round trip back to the view.
+TEST(SlfDirections, LocalSpaceIsTheViewInTheTexelsFrame) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> g;
+  prt::SlfGrid local;
+  local.space = prt::SlfDirectionSpace::kLocal;
+  EXPECT_TRUE(prt::slf_grid_uses_normals(local));
+  EXPECT_NEAR(prt::slf_polar_span(local), M_PI / 2, 1e-15);
+  for (int i = 0; i < 100; ++i) {
+    const Eigen::Vector3d n = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const Eigen::Vector3d v = Eigen::Vector3d(g(rng), g(rng), g(rng)).normalized();
+    const Eigen::Matrix3d f = prt::slf_local_frame(n);
+    EXPECT_NEAR((f.transpose() * f - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+    EXPECT_LT((f.col(1) - f.col(0).cross(n)).norm(), 1e-12);
+    EXPECT_LT((f.col(2) - n).norm(), 1e-15);
+    const Eigen::Vector3d up_tangent = (Eigen::Vector3d::UnitY() - n.y() * n).normalized();
+    EXPECT_LT((f.col(0) - up_tangent).norm(), 1e-12);
+    const Eigen::Vector3d l = prt::slf_grid_space(local, v, n);
+    EXPECT_NEAR(l.norm(), 1.0, 1e-12);
+    EXPECT_LT((prt::slf_grid_view(local, l, n) - v).norm(), 1e-12);
+    const Eigen::Vector2d xi = prt::slf_grid_coordinates(local, l);
+    const double polar = std::acos(std::clamp(v.dot(n), -1.0, 1.0));
+    EXPECT_NEAR(xi.y(), std::min(1.0, polar / (M_PI / 2)), 1e-9);
+    // Azimuth from the up tangent, toward t x n (Eq. 1's +X from its -Z).
+    const double azimuth = std::atan2(v.dot(up_tangent.cross(n)), v.dot(up_tangent));
+    EXPECT_NEAR(std::remainder(M_PI * (xi.x() - 1.0) - azimuth, 2 * M_PI), 0.0, 1e-9);
+    // The reflection lies half a turn around the local pole from the view.
+    if (v.dot(n) > 0) {
+      prt::SlfGrid reflected;
+      reflected.space = prt::SlfDirectionSpace::kReflected;
+      const Eigen::Vector2d r = prt::slf_grid_coordinates(
+          local, prt::slf_grid_space(local, prt::slf_grid_space(reflected, v, n), n));
+      EXPECT_NEAR(r.y(), xi.y(), 1e-9);
+      EXPECT_NEAR(std::remainder(M_PI * (r.x() - xi.x()) - M_PI, 2 * M_PI), 0.0, 1e-9);
+    }
+  }
+  // Along the pole's axis the frame falls back to the world's -Z, and stays a frame.
+  for (const double y : {1.0, -1.0}) {
+    const Eigen::Matrix3d f = prt::slf_local_frame({0, y, 0});
+    EXPECT_LT((f.col(0) + Eigen::Vector3d::UnitZ()).norm(), 1e-15);
+    EXPECT_NEAR(std::abs(f.determinant()), 1.0, 1e-15);
+  }
+  // The pole and the horizon: the first row's edge and the last's.
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 2, 3).normalized();
+  const Eigen::Vector3d t = prt::slf_local_frame(n).col(0);
+  EXPECT_NEAR(prt::slf_grid_coordinates(local, prt::slf_grid_space(local, n, n)).y(), 0.0, 1e-7);
+  EXPECT_NEAR(prt::slf_grid_coordinates(local, prt::slf_grid_space(local, t, n)).y(), 1.0, 1e-12);
+  EXPECT_EQ(prt::slf_grid_coordinates(local, prt::slf_grid_space(local, -n, n)).y(), 1.0);
+  // A cell centre's polar angle spans the hemisphere, not the sphere.
+  local.elevation = 4;
+  EXPECT_NEAR(prt::slf_grid_direction(local, 3 * local.azimuth).y(), std::cos(3.5 * M_PI / 8),
+              1e-12);
+}
+
+// On a plane facing +Y the local frame is the world's (the pole +Y, azimuth 0 toward -Z), and
+// the local grid's W rows over the hemisphere are the upper W of a view grid of 2 W rows over
+// the sphere, cell for cell: the two bakes must agree there to within two view bakes of
+// different seeds, and differ from the view grid of W rows at the same cell.
+TEST(SlfBake, ALocalGridHoldsTheUpperHalfOfAViewGridOfTwiceTheRows) {
+  const meshes::Mesh plane = meshes::make_plane(2.f, 1);
+  const meshes::Atlas atlas = meshes::make_atlas(plane, 8, 8);
+  const probes::Probe probe = probes::make_from_function(64, 32, [](const Eigen::Vector3d& d) {
+    const float v = float(1.0 + 0.8 * d.x() + 0.3 * d.y() - 0.4 * d.z());
+    return probes::Rgb(v, 0.5f * v, 0.25f);
+  });
+  prt::SlfBakeOptions o;
+  o.grid = {8, 8};
+  o.spp = 128;
+  o.bounces = 0;
+  o.material.kind = prt::MaterialKind::kPhong;
+  o.material.exponent = 8;
+  o.material.specular = 0.6f;
+  o.material.albedo = Eigen::Vector3f::Constant(0.2f);
+  const prt::SlfMatrix view = prt::bake_slf(plane, atlas, probe, o);
+  o.seed = 2;
+  const prt::SlfMatrix view_again = prt::bake_slf(plane, atlas, probe, o);
+  o.grid = {8, 4, prt::SlfDirectionSpace::kLocal};
+  const prt::SlfMatrix local = prt::bake_slf(plane, atlas, probe, o);
+  o.grid = {8, 4};
+  const prt::SlfMatrix coarse = prt::bake_slf(plane, atlas, probe, o);
+  ASSERT_EQ(local.shape.row_count, view.shape.row_count);
+  const std::size_t upper = 3 * 8 * 4;  // floats of the view grid's upper 4 rows
+  ASSERT_EQ(local.shape.columns(), upper);
+  double held = 0, noise = 0, same_cell = 0;
+  for (std::uint64_t r = 0; r < view.shape.row_count; ++r)
+    for (std::size_t k = 0; k < upper; ++k) {
+      const double l = local.row(r)[k], v = view.row(r)[k];
+      held += (l - v) * (l - v);
+      noise += (v - view_again.row(r)[k]) * (v - view_again.row(r)[k]);
+      same_cell += (l - coarse.row(r)[k]) * (l - coarse.row(r)[k]);
+    }
+  EXPECT_LT(std::sqrt(held / noise), 1.2);
+  EXPECT_GT(std::sqrt(same_cell / noise), 4.0);
+}
+
 TEST(SlfBake, DamagedFilesAreRefusedNamingTheFile) {
   const Scene s;
   const fs::path good = scratch("slf_bake", "good.slf");

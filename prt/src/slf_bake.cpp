@@ -245,12 +245,12 @@ struct GridCell {
   double top, bottom;
   GridCell(const SlfGrid& grid, int column)
       : i(column % grid.azimuth),
-        top(std::cos(kSlfPi * (column / grid.azimuth) / grid.elevation)),
-        bottom(std::cos(kSlfPi * (column / grid.azimuth + 1) / grid.elevation)) {}
+        top(std::cos(slf_polar_span(grid) * (column / grid.azimuth) / grid.elevation)),
+        bottom(std::cos(slf_polar_span(grid) * (column / grid.azimuth + 1) / grid.elevation)) {}
 };
 
-// The world direction at (a, b) in [0, 1)^2 over the cell: azimuth linear in a, cosine of
-// the polar angle linear in b, so uniform in solid angle inside the cell.
+// The direction in the grid's axes at (a, b) in [0, 1)^2 over the cell: azimuth linear in a,
+// cosine of the polar angle linear in b, so uniform in solid angle inside the cell.
 Eigen::Vector3d cell_direction(const SlfGrid& grid, const GridCell& cell, double a, double b) {
   const double cos_polar = std::clamp(cell.top + b * (cell.bottom - cell.top), -1.0, 1.0);
   return slf_direction(2 * (cell.i + a) / grid.azimuth, std::acos(cos_polar) / kSlfPi);
@@ -262,8 +262,9 @@ Eigen::Vector3d cell_direction(const SlfGrid& grid, const GridCell& cell, double
 // shadow ray each, prt::SharedLights), each cell pairing every one of them with its own view,
 // again stratified over the cell: per cell as many light-view pairs as the paths' own light
 // samples would give light_samples times over, for the price of BRDF evaluations. In the
-// reflected space a cell's samples are mirrored about the shading normal into views
-// (prt/slf_directions.h), uniform over the cell's image since reflection keeps solid angle.
+// reflected and local spaces a cell's samples are mirrored about the shading normal or
+// turned out of its frame into views (prt/slf_directions.h), uniform over the cell's image
+// since both keep solid angle.
 void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_t texel,
               std::uint64_t row, const SlfBakeOptions& o, float* out) {
   const int directions = o.grid.directions();
@@ -283,7 +284,7 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
   const double ratio = lights.size() > 0 ? double(o.light_samples) : 0.0;
   const Eigen::Vector3d normal = point.frame.col(2);
   const auto view_at = [&](const GridCell& cell, const Eigen::Vector2d& ab) {
-    return slf_grid_space(o.grid, cell_direction(o.grid, cell, ab.x(), ab.y()), normal);
+    return slf_grid_view(o.grid, cell_direction(o.grid, cell, ab.x(), ab.y()), normal);
   };
   for (int column = 0; column < directions; ++column) {
     const GridCell cell(o.grid, column);

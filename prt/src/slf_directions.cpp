@@ -1,5 +1,7 @@
 #include "prt/slf_directions.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -30,15 +32,63 @@ Eigen::Vector2d slf_coordinates(const Eigen::Vector3d& direction) {
   return {1.0 + std::atan2(direction.x(), -direction.z()) / M_PI, std::acos(y) / M_PI};
 }
 
-Eigen::Vector3d slf_grid_direction(const SlfGrid& grid, int column) {
-  const int i = column % grid.azimuth, j = column / grid.azimuth;
-  return slf_direction(2.0 * (i + 0.5) / grid.azimuth, (j + 0.5) / grid.elevation);
+bool slf_grid_uses_normals(const SlfGrid& grid) {
+  return grid.space != SlfDirectionSpace::kView;
 }
 
+double slf_polar_span(const SlfGrid& grid) {
+  return grid.space == SlfDirectionSpace::kLocal ? 0.5 * M_PI : M_PI;
+}
+
+Eigen::Vector3d slf_grid_direction(const SlfGrid& grid, int column) {
+  const int i = column % grid.azimuth, j = column / grid.azimuth;
+  return slf_direction(2.0 * (i + 0.5) / grid.azimuth,
+                       (j + 0.5) / grid.elevation * slf_polar_span(grid) / M_PI);
+}
+
+Eigen::Matrix3d slf_local_frame(const Eigen::Vector3d& normal) {
+  // The renderers' shaders repeat this rule in float (render/slf_renderer.cpp); the threshold
+  // only decides texels whose normal is vertical to float precision.
+  Eigen::Vector3d tangent = Eigen::Vector3d::UnitY() - normal.y() * normal;
+  if (tangent.squaredNorm() < 1e-8)
+    tangent = -Eigen::Vector3d::UnitZ() - normal.dot(-Eigen::Vector3d::UnitZ()) * normal;
+  tangent.normalize();
+  Eigen::Matrix3d frame;
+  frame.col(0) = tangent;
+  frame.col(1) = tangent.cross(normal);
+  frame.col(2) = normal;
+  return frame;
+}
+
+// Eq. 1's axes put the pole on +Y and azimuth 0 on -Z; the local grid's are the normal and
+// the tangent, so a local direction is (bitangent, normal, -tangent) components.
 Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
                                const Eigen::Vector3d& normal) {
-  if (grid.space == SlfDirectionSpace::kView) return view;
-  return 2.0 * normal.dot(view) * normal - view;
+  switch (grid.space) {
+    case SlfDirectionSpace::kView:
+      return view;
+    case SlfDirectionSpace::kReflected:
+      return 2.0 * normal.dot(view) * normal - view;
+    case SlfDirectionSpace::kLocal: {
+      const Eigen::Matrix3d f = slf_local_frame(normal);
+      return {f.col(1).dot(view), f.col(2).dot(view), -f.col(0).dot(view)};
+    }
+  }
+  return view;
+}
+
+Eigen::Vector3d slf_grid_view(const SlfGrid& grid, const Eigen::Vector3d& grid_direction,
+                              const Eigen::Vector3d& normal) {
+  if (grid.space != SlfDirectionSpace::kLocal)
+    return slf_grid_space(grid, grid_direction, normal);  // its own inverse
+  const Eigen::Matrix3d f = slf_local_frame(normal);
+  return grid_direction.x() * f.col(1) + grid_direction.y() * f.col(2) -
+         grid_direction.z() * f.col(0);
+}
+
+Eigen::Vector2d slf_grid_coordinates(const SlfGrid& grid, const Eigen::Vector3d& grid_direction) {
+  const Eigen::Vector2d xi = slf_coordinates(grid_direction);
+  return {xi.x(), std::min(1.0, xi.y() * M_PI / slf_polar_span(grid))};
 }
 
 }  // namespace prt

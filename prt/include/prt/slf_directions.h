@@ -20,6 +20,15 @@
 // a view's angle to the normal maps to the same angle, so a rim lit from behind changes
 // along the polar axis at half the angular rate. Reflection is its own inverse and keeps
 // solid angle, so a cell's mean over r is its mean over the views it maps to.
+//
+// Both of those grids spend half their cells below each point's horizon, where no view of the
+// front of the surface falls, and their cells along the horizon straddle it. The local grid
+// lays the same Z x W cells over the point's hemisphere alone, in its own frame: the pole is
+// the shading normal and azimuth 0 the world's up projected onto the tangent plane (the
+// world's -Z where the normal is vertical), so the polar rows span [0, pi/2] and end at the
+// horizon, at twice the polar resolution for the same columns. Views below the horizon (a
+// shading normal turned from the eye) read the horizon's row. In that frame a view and its
+// mirror image differ by half a turn of azimuth, so one local grid serves both.
 #pragma once
 
 #include "common/enum_names.h"
@@ -30,10 +39,11 @@
 
 namespace prt {
 
-enum class SlfDirectionSpace : std::uint16_t { kView = 0, kReflected = 1 };
+enum class SlfDirectionSpace : std::uint16_t { kView = 0, kReflected = 1, kLocal = 2 };
 inline constexpr auto kSlfDirectionSpaceNames = common::enum_table<SlfDirectionSpace>(
-    "direction space",
-    {{SlfDirectionSpace::kView, "view"}, {SlfDirectionSpace::kReflected, "reflected"}});
+    "direction space", {{SlfDirectionSpace::kView, "view"},
+                        {SlfDirectionSpace::kReflected, "reflected"},
+                        {SlfDirectionSpace::kLocal, "local"}});
 
 struct SlfGrid {
   int azimuth = 32;    // Z
@@ -47,13 +57,30 @@ struct SlfGrid {
 Eigen::Vector3d slf_direction(double xi1, double xi2);
 // Eq. 2: (xi1, xi2) of a direction (need not be unit; zero gives (1, 0.5)).
 Eigen::Vector2d slf_coordinates(const Eigen::Vector3d& direction);
-// The centre of column j Z + i.
+// The centre of column j Z + i, in the grid's axes.
 Eigen::Vector3d slf_grid_direction(const SlfGrid& grid, int column);
 
+// Whether the grid's directions depend on each point's shading normal (every space but the
+// view's), so that a renderer needs the normals.
+bool slf_grid_uses_normals(const SlfGrid& grid);
+// The polar angle the W rows span: pi over the sphere, pi / 2 over the local hemisphere.
+double slf_polar_span(const SlfGrid& grid);
+
+// The local grid's frame at a unit shading normal: columns the tangent t (azimuth 0), the
+// bitangent t x n (a quarter turn of azimuth on, as Eq. 1's +X is from its -Z) and the
+// normal n.
+Eigen::Matrix3d slf_local_frame(const Eigen::Vector3d& normal);
+
 // Where a unit view (from the point toward the viewer) sits on the grid, at a point of unit
-// shading normal `normal`: the view itself, or its reflection. Its own inverse: it also
-// turns a grid direction into the view it stands for.
+// shading normal `normal`, as a unit direction in the grid's own axes (Eq. 1's, +Y the
+// pole): the view itself, its reflection, or the view in the local frame.
 Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
                                const Eigen::Vector3d& normal);
+// The inverse: the view a direction in the grid's axes stands for.
+Eigen::Vector3d slf_grid_view(const SlfGrid& grid, const Eigen::Vector3d& grid_direction,
+                              const Eigen::Vector3d& normal);
+// (xi1, xi2) of a direction in the grid's axes, xi2 over the grid's polar span (clamped to 1
+// below the local grid's horizon).
+Eigen::Vector2d slf_grid_coordinates(const SlfGrid& grid, const Eigen::Vector3d& grid_direction);
 
 }  // namespace prt
