@@ -729,10 +729,13 @@ TEST(SlfRenderer, AutomaticShadingFollowsTheCostOfEachPath) {
 // A grid of reflected directions: each texel looks its view up mirrored about its own
 // normal, in the CPU reference (against the view-grid model looked up at the mirror image by
 // hand) and on every GL path (against that reference).
-render::SlfModel reflected(render::SlfModel m) {
-  m.grid.space = prt::SlfDirectionSpace::kReflected;
+render::SlfModel in_space(render::SlfModel m, prt::SlfDirectionSpace space) {
+  m.grid.space = space;
   m.texel_normals = render::texel_normals_from_uv(m);
   return m;
+}
+render::SlfModel reflected(const render::SlfModel& m) {
+  return in_space(m, prt::SlfDirectionSpace::kReflected);
 }
 
 TEST(SlfReference, ReflectedGridLooksUpEachTexelsMirrorImage) {
@@ -780,6 +783,69 @@ TEST(SlfRenderer, ReflectedGridMatchesTheCpuReferenceOnEveryPath) {
     // The view grid's image differs: the lookup really is mirrored.
     const render::SlfReferenceOptions options{true, Vector3f::Zero()};
     EXPECT_GT(compare(render::render_slf_reference(sphere_model(), camera, options),
+                      render::render_slf_reference(model, camera, options), 0.01)
+                  .value_differs,
+              100);
+  }
+}
+
+// A grid of local directions: each texel looks its view up over its own hemisphere, polar
+// from its normal and azimuth from the world's up projected onto its tangent plane. The CPU
+// reference against the view maps read at those coordinates, written out here (bilinear in
+// azimuth and polar, wrapped and clamped), and every GL path against that reference.
+TEST(SlfReference, LocalGridLooksUpEachTexelsViewOverItsHemisphere) {
+  const render::SlfModel m = in_space(sphere_model(), prt::SlfDirectionSpace::kLocal);
+  EXPECT_NO_THROW(m.validate());
+  const Vector3d eye(0.4, 1.5, 2.5);
+  const int side = m.map_width, z = m.grid.azimuth, w = m.grid.elevation;
+  int checked = 0;
+  for (int x : {20, 33, 47, 70, 101})
+    for (int y : {12, 30, 51, 88, 113}) {
+      const std::size_t t = std::size_t(y) * side + std::size_t(x);
+      if (m.texel_cluster[t] < 0) continue;
+      const Vector3d n = m.texel_normals[t].cast<double>();
+      const Vector3d d = (eye - m.texel_positions[t].cast<double>()).normalized();
+      const Vector3d up = (Vector3d::UnitY() - n.y() * n).normalized();
+      const double azimuth = std::atan2(d.dot(up.cross(n)), d.dot(up));  // in (-pi, pi]
+      const double polar = std::acos(std::clamp(d.dot(n), -1.0, 1.0));
+      const double s = (azimuth / M_PI + 1.0) * 0.5 * z - 0.5;
+      const double r = std::min(1.0, polar / (M_PI / 2)) * w - 0.5;
+      const int i0 = int(std::floor(s)), j0 = int(std::floor(r));
+      const int cluster = m.texel_cluster[t];
+      Vector3d expected = Vector3d::Zero();
+      for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+          const int i = ((i0 + a) % z + z) % z, j = std::clamp(j0 + b, 0, w - 1);
+          const double weight = (a ? s - i0 : 1 - (s - i0)) * (b ? r - j0 : 1 - (r - j0));
+          for (int slice = 0; slice <= m.components; ++slice) {
+            const double coefficient =
+                slice == 0 ? 1.0 : m.texel_weights[t * m.components + std::size_t(slice - 1)];
+            const float* rgb = m.view_slice(cluster, slice) + 3 * std::size_t(j * z + i);
+            expected += weight * coefficient * Vector3d(rgb[0], rgb[1], rgb[2]);
+          }
+        }
+      const Vector2f centre((x + 0.5f) / side, (y + 0.5f) / side);
+      const Vector3f e = expected.cwiseMax(0.0).cast<float>();
+      EXPECT_LT((render::slf_radiance_toward(m, centre, eye) - e).norm(), 1e-5 * e.norm() + 1e-7)
+          << x << ", " << y;
+      EXPECT_LT((render::slf_radiance(m, centre, 3.0 * d) - e).norm(), 1e-5 * e.norm() + 1e-7);
+      ++checked;
+    }
+  EXPECT_GT(checked, 10);
+  render::SlfModel bad = m;
+  bad.texel_normals.clear();
+  expect_refused(bad, "texel_normals");
+}
+
+TEST(SlfRenderer, LocalGridMatchesTheCpuReferenceOnEveryPath) {
+  render::GlContext ctx;
+  const render::SlfModel model = in_space(sphere_model(), prt::SlfDirectionSpace::kLocal);
+  for (const Vector3d& eye : {Vector3d(0.3, 0.2, 3.5), Vector3d(-2.0, 2.4, 1.0)}) {
+    const render::Camera camera = camera_at(eye, 80, 60);
+    expect_every_path_matches_the_reference(model, camera, eye.y() > 1 ? "above" : "front",
+                                            camera.width * camera.height / 8);
+    const render::SlfReferenceOptions options{true, Vector3f::Zero()};
+    EXPECT_GT(compare(render::render_slf_reference(reflected(sphere_model()), camera, options),
                       render::render_slf_reference(model, camera, options), 0.01)
                   .value_differs,
               100);

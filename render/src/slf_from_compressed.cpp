@@ -82,8 +82,7 @@ SlfModel slf_model_from_compressed(const meshes::Mesh& mesh, const meshes::Atlas
   model.texel_cluster.assign(texels, -1);
   model.texel_weights.assign(texels * k, 0.f);
   model.texel_positions = meshes::texel_points(mesh, atlas);
-  if (grid.space == prt::SlfDirectionSpace::kReflected)
-    model.texel_normals = meshes::texel_normals(mesh, atlas);
+  if (prt::slf_grid_uses_normals(grid)) model.texel_normals = meshes::texel_normals(mesh, atlas);
   std::size_t row = 0;
   for (std::size_t t = 0; t < texels; ++t) {
     if (atlas.texel_triangle[t] < 0) continue;

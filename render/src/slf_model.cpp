@@ -88,9 +88,10 @@ void SlfModel::validate() const {
     if (!texel_positions[t].allFinite())
       slf_model_checks::refuse("texel_positions[" + std::to_string(t) +
                                "] is not finite; rebuild the model from finite data");
-  if (grid.space == prt::SlfDirectionSpace::kReflected) {
+  if (prt::slf_grid_uses_normals(grid)) {
     slf_model_checks::check_size(texel_normals.size(), texels, "texel_normals",
-                                 "one per texel (map_width x map_height) for reflected directions");
+                                 "one per texel (map_width x map_height) for reflected or local "
+                                 "directions");
     for (std::size_t t = 0; t < texels; ++t)
       if (texel_cluster[t] >= 0 && !(std::abs(texel_normals[t].squaredNorm() - 1.f) < 1e-3f))
         slf_model_checks::refuse(
@@ -99,7 +100,7 @@ void SlfModel::validate() const {
   } else if (!texel_normals.empty()) {
     slf_model_checks::refuse(
         "texel_normals is given for a grid of view directions; only "
-        "reflected directions use it");
+        "reflected and local directions use it");
   }
   slf_model_checks::check_finite(texel_weights, "texel_weights");
   slf_model_checks::check_finite(view_maps, "view_maps");

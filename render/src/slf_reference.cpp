@@ -12,8 +12,9 @@
 
 namespace render {
 
-SlfDirectionTaps slf_direction_taps(const prt::SlfGrid& grid, const Eigen::Vector3d& direction) {
-  const Eigen::Vector2d xi = prt::slf_coordinates(direction);
+SlfDirectionTaps slf_direction_taps(const prt::SlfGrid& grid,
+                                    const Eigen::Vector3d& grid_direction) {
+  const Eigen::Vector2d xi = prt::slf_grid_coordinates(grid, grid_direction);
   // Column i's centre sits at xi1 = 2 (i + 0.5) / Z and row j's at xi2 = (j + 0.5) / W.
   const double s = xi.x() * 0.5 * grid.azimuth - 0.5, t = xi.y() * grid.elevation - 0.5;
   const double s0 = std::floor(s), t0 = std::floor(t);
@@ -84,10 +85,10 @@ Eigen::Vector3f blend(const SlfModel& model, const Eigen::Vector2f& uv, const Ta
 
 namespace slf_reference_taps {
 
-// Texel `texel`'s taps toward the unit view `d` (from its point toward the viewer), mirrored
-// about its normal first when the grid holds reflected directions.
+// Texel `texel`'s taps toward the unit view `d` (from its point toward the viewer), taken into
+// the grid's space at its normal first (mirrored, or into its local frame).
 SlfDirectionTaps texel_taps(const SlfModel& model, std::size_t texel, const Eigen::Vector3d& d) {
-  if (model.grid.space == prt::SlfDirectionSpace::kView) return slf_direction_taps(model.grid, d);
+  if (!prt::slf_grid_uses_normals(model.grid)) return slf_direction_taps(model.grid, d);
   return slf_direction_taps(
       model.grid, prt::slf_grid_space(model.grid, d, model.texel_normals[texel].cast<double>()));
 }
@@ -96,7 +97,7 @@ SlfDirectionTaps texel_taps(const SlfModel& model, std::size_t texel, const Eige
 
 Eigen::Vector3f slf_radiance(const SlfModel& model, const Eigen::Vector2f& uv,
                              const Eigen::Vector3d& direction) {
-  if (model.grid.space == prt::SlfDirectionSpace::kView) {
+  if (!prt::slf_grid_uses_normals(model.grid)) {
     const SlfDirectionTaps taps = slf_direction_taps(model.grid, direction);
     return slf_reference_taps::blend(model, uv, [&](std::size_t) { return taps; });
   }

@@ -134,16 +134,30 @@ std::string reconstruction_declarations(const SlfModel& model, const TileLayout&
   s += "const vec2 kGridScale = vec2(" + float_literal(0.5 * model.grid.azimuth) + ", " +
        float_literal(model.grid.elevation) + ");\n";
   s += "const float kInvPi = " + float_literal(1.0 / 3.14159265358979323846) + ";\n";
+  s +=
+      "const float kInvPolarSpan = " + float_literal(1.0 / prt::slf_polar_span(model.grid)) + ";\n";
+  // A view into the grid's axes at the texel's normal n: prt::slf_grid_space, in float.
+  if (model.grid.space == prt::SlfDirectionSpace::kReflected)
+    s += "vec3 grid_space(vec3 d, vec3 n) { return reflect(-d, n); }\n";
+  if (model.grid.space == prt::SlfDirectionSpace::kLocal)
+    s += "vec3 grid_space(vec3 d, vec3 n) {\n"
+         "  vec3 t = vec3(0.0, 1.0, 0.0) - n.y * n;\n"
+         "  if (dot(t, t) < 1e-8) t = vec3(0.0, 0.0, -1.0) + n.z * n;\n"
+         "  t = normalize(t);\n"
+         "  return vec3(dot(cross(t, n), d), dot(n, d), -dot(t, d));\n"
+         "}\n";
   return s;
 }
 
-// From the direction `d` (toward the viewer, or its mirror image) to `p`, its place in a
-// view-map tile.
+// From the direction `d` in the grid's axes (the view, its mirror image or the view in the
+// texel's frame) to `p`, its place in a view-map tile.
 std::string direction_to_tile(const std::string& indent, const std::string& d = "d") {
   // Eq. 2; atan(0, 0) is undefined in GLSL, 0 on the CPU.
   return indent + "float azimuth = (" + d + ".x == 0.0 && " + d + ".z == 0.0) ? 0.0 : atan(" + d +
-         ".x, -" + d + ".z);\n" + indent + "vec2 xi = vec2(1.0 + azimuth * kInvPi, acos(clamp(" +
-         d + ".y, -1.0, 1.0)) * kInvPi);\n" + indent + "vec2 p = vec2(1.0) + xi * kGridScale;\n";
+         ".x, -" + d + ".z);\n" + indent +
+         "vec2 xi = vec2(1.0 + azimuth * kInvPi, min(acos(clamp(" + d +
+         ".y, -1.0, 1.0)) * kInvPolarSpan, 1.0));\n" + indent +
+         "vec2 p = vec2(1.0) + xi * kGridScale;\n";
 }
 
 // Adds to `l` cluster `t`'s reconstruction at `p` with the mean's coefficient `a0` and the
@@ -188,19 +202,19 @@ std::string view_sum(int k, const std::string& indent) {
 // both sides of a branch for its whole SIMD group, but leaves a loop as soon as no lane of
 // the group needs another iteration, so the common case pays for one reconstruction only.
 // Without `shared`, each iteration takes one texel (four iterations where all are used).
-// A grid of reflected directions takes one texel an iteration too: each texel mirrors the
-// fragment's direction about its own normal (the CPU reference's slf_radiance), so the four
-// have four places in the view maps.
+// A grid of reflected or local directions takes one texel an iteration too: each texel takes
+// the fragment's direction into the grid's space at its own normal (the CPU reference's
+// slf_radiance), so the four have four places in the view maps.
 // Deferred: the atlas coordinate comes from the uv pre-pass's texture and the direction from
 // the pixel's ray (the CPU reference's Camera::pixel_direction, reversed).
 std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool shared,
                             bool deferred) {
   const int k = model.components, layers = (k + 3) / 4;
-  const bool reflected = model.grid.space == prt::SlfDirectionSpace::kReflected;
-  shared = shared && !reflected;
+  const bool per_texel = prt::slf_grid_uses_normals(model.grid);
+  shared = shared && !per_texel;
   std::string s = "#version 450 core\n";
   s += "layout(location = 0) out vec4 o_colour;\n";
-  if (reflected)
+  if (per_texel)
     s += "layout(binding = " + std::to_string(kNormalsUnit) + ") uniform sampler2D u_normals;\n";
   if (deferred) {
     s += "layout(binding = " + std::to_string(kUvUnit) + ") uniform sampler2D u_uv;\n";
@@ -216,7 +230,7 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
          "  vec3 d = -normalize(u_forward + ndc.x * u_right + ndc.y * u_up);\n";
   else
     s += "  vec3 d = normalize(u_eye - v_world);\n";
-  if (!reflected) s += direction_to_tile("  ");
+  if (!per_texel) s += direction_to_tile("  ");
   s += "  vec2 st = v_uv * kMap - 0.5;\n"
        "  vec2 b = floor(st);\n"
        "  vec2 f = st - b;\n"
@@ -242,10 +256,10 @@ std::string fragment_shader(const SlfModel& model, const TileLayout& tiles, bool
     s += "    vec4 take = left.x > 0.0 ? vec4(1, 0, 0, 0) : left.y > 0.0 ? vec4(0, 1, 0, 0)\n"
          "              : left.z > 0.0 ? vec4(0, 0, 1, 0) : left;\n";
   }
-  if (reflected) {
+  if (per_texel) {
     s += "    ivec2 at = take.x > 0.0 ? lo : take.y > 0.0 ? ivec2(hi.x, lo.y)\n"
          "             : take.z > 0.0 ? ivec2(lo.x, hi.y) : hi;\n"
-         "    vec3 r = reflect(-d, texelFetch(u_normals, at, 0).xyz);\n";
+         "    vec3 r = grid_space(d, texelFetch(u_normals, at, 0).xyz);\n";
     s += direction_to_tile("    ", "r");
   }
   s += "    left -= take;\n"
@@ -283,17 +297,17 @@ std::string block_vertex_shader(const SlfModel& model) {
 }
 
 // Texture space: the texel's own reconstruction toward the eye from its surface point
-// (mirrored about the texel's normal for a grid of reflected directions), unclamped (the clamp
-// follows the spatial blend, in the mesh's pass). Unused texels are 0, as the blend leaves them
-// out. A loop of at most one iteration rather than an if, so that a 4 x 4 group of unused texels
-// skips the work (see fragment_shader).
+// (into the grid's space at the texel's normal for reflected or local directions), unclamped (the
+// clamp follows the spatial blend, in the mesh's pass). Unused texels are 0, as the blend leaves
+// them out. A loop of at most one iteration rather than an if, so that a 4 x 4 group of unused
+// texels skips the work (see fragment_shader).
 std::string texel_fragment_shader(const SlfModel& model, const TileLayout& tiles) {
   const int k = model.components, layers = (k + 3) / 4;
   std::string s = "#version 450 core\n";
   s += "layout(location = 0) out vec4 o_colour;\nuniform vec3 u_eye;\n";
   s += "layout(binding = " + std::to_string(kPositionsUnit) + ") uniform sampler2D u_positions;\n";
-  const bool reflected = model.grid.space == prt::SlfDirectionSpace::kReflected;
-  if (reflected)
+  const bool per_texel = prt::slf_grid_uses_normals(model.grid);
+  if (per_texel)
     s += "layout(binding = " + std::to_string(kNormalsUnit) + ") uniform sampler2D u_normals;\n";
   s += reconstruction_declarations(model, tiles);
   s += "void main() {\n"
@@ -302,7 +316,7 @@ std::string texel_fragment_shader(const SlfModel& model, const TileLayout& tiles
        "  vec3 l = vec3(0.0);\n"
        "  for (int once = t >= 0 ? 1 : 0; once > 0; --once) {\n"
        "    vec3 d = normalize(u_eye - texelFetch(u_positions, texel, 0).xyz);\n";
-  if (reflected) s += "    d = reflect(-d, texelFetch(u_normals, texel, 0).xyz);\n";
+  if (per_texel) s += "    d = grid_space(d, texelFetch(u_normals, texel, 0).xyz);\n";
   s += direction_to_tile("    ");
   s += "    float a0 = 1.0;\n";
   for (int l = 0; l < layers; ++l)
@@ -494,7 +508,7 @@ struct SlfRenderer::Impl {
   GLsizei vertex_count = 0;
   // Texture space: texel points, the radiance map and its framebuffer, the block instances.
   GLuint positions_texture = 0, radiance_texture = 0, radiance_fbo = 0;
-  GLuint normals_texture = 0;  // reflected directions: each texel's normal
+  GLuint normals_texture = 0;  // reflected or local directions: each texel's normal
   GLuint block_vao = 0, block_vbo = 0;
   std::vector<slf_gl::TexelBlock> blocks;
   std::vector<std::int32_t> visible_blocks;
@@ -629,8 +643,7 @@ SlfRenderer::Impl::Impl(const SlfModel& model, const probes::Probe* probe,
     slf_gl::texture_parameters(GL_TEXTURE_2D, GL_NEAREST);
   };
   upload(model.texel_positions, positions_texture);
-  if (model.grid.space == prt::SlfDirectionSpace::kReflected)
-    upload(model.texel_normals, normals_texture);
+  if (prt::slf_grid_uses_normals(model.grid)) upload(model.texel_normals, normals_texture);
   std::fill(points.begin(), points.end(), 0.f);
   glGenTextures(1, &radiance_texture);
   glBindTexture(GL_TEXTURE_2D, radiance_texture);

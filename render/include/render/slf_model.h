@@ -37,9 +37,9 @@ struct SlfModel {
   // triangle); any finite value where the cluster is -1. Texture-space shading takes a
   // texel's view direction from it, as the paper does per texel.
   std::vector<Eigen::Vector3f> texel_positions;
-  // X Y unit shading normals (meshes::texel_normals), where the grid holds reflected
-  // directions (prt/slf_directions.h): each texel mirrors its view about its own normal
-  // before the grid lookup, as its bake did. Empty for view directions.
+  // X Y unit shading normals (meshes::texel_normals), where the grid holds reflected or
+  // local directions (prt/slf_directions.h): each texel takes its view into the grid's space
+  // at its own normal before the grid lookup, as its bake did. Empty for view directions.
   std::vector<Eigen::Vector3f> texel_normals;
   // clusters (k + 1) Z W 3: cluster, slice (0 the mean, 1 + j component j), direction
   // column j Z + i, then RGB. The view maps V.

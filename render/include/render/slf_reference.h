@@ -18,8 +18,9 @@
 //  - Every texel uses the fragment's own direction (slf_radiance), or, as the paper does, its
 //    own: from the texel's surface point toward the eye (slf_radiance_toward, what
 //    texture-space shading computes). The two differ by the angle a texel subtends at the eye.
-//  - A grid of reflected directions (prt/slf_directions.h) mirrors each texel's direction
-//    about that texel's normal (SlfModel::texel_normals) before the lookup, in both forms.
+//  - A grid of reflected or local directions (prt/slf_directions.h) takes each texel's
+//    direction into the grid's space at that texel's normal (SlfModel::texel_normals) before
+//    the lookup, in both forms: mirrored about it, or into its local frame.
 //  - Negative radiance is clamped to 0 per channel once, after the spatial blend: CPCA's
 //    reconstruction of a noisy matrix undershoots where the data is near zero (a silhouette
 //    whose red and green go below zero shows as blue dots). Clamping each texel before the
@@ -40,14 +41,16 @@
 
 namespace render {
 
-// Where a direction falls on the grid: the two azimuth columns (wrapped) and the two polar
-// rows (clamped) around it with the weight of the second of each pair. One definition for
-// the CPU reference and for tests of the GL path's tile addressing.
+// Where a direction in the grid's axes (prt::slf_grid_space) falls on the grid: the two
+// azimuth columns (wrapped) and the two polar rows (clamped) around it with the weight of
+// the second of each pair. One definition for the CPU reference and for tests of the GL
+// path's tile addressing.
 struct SlfDirectionTaps {
   int column[2] = {0, 0}, row[2] = {0, 0};
   double column_weight = 0, row_weight = 0;  // of column[1], row[1]
 };
-SlfDirectionTaps slf_direction_taps(const prt::SlfGrid& grid, const Eigen::Vector3d& direction);
+SlfDirectionTaps slf_direction_taps(const prt::SlfGrid& grid,
+                                    const Eigen::Vector3d& grid_direction);
 
 // Radiance (linear RGB) from atlas point `uv` toward `direction` (need not be unit).
 // The model must be valid (SlfModel::validate); uv outside [0, 1]^2 clamps to the border
