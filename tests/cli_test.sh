@@ -383,6 +383,12 @@ if [[ -f $forest ]]; then
   expect_code 0 && [[ -s $tmp/tri.exr ]]; check "render: a per-triangle .slfc renders with its own atlas ($err)" $?
   run slf "$tmp/cube.obj" --probe "$forest" --direction-space view --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/view.slfc" --no-cache --json -q
   expect_code 0 && [[ $(jget - /direction_space <<<"$out") == view ]]; check "slf --direction-space view: the paper's grid, reported ($err)" $?
+  run slf "$tmp/cube.obj" --probe "$forest" --direction-space local --samples 32x32 --directions 8x4 --spp 2 --clusters 4 --pcs 2 -o "$tmp/local.slfc" --no-cache --json -q
+  expect_code 0 && [[ $(jget - /direction_space <<<"$out") == local ]]; check "slf --direction-space local: each texel's hemisphere, reported ($err)" $?
+  run render "$tmp/local.slfc" --probe "$forest" --width 16 --height 12 --frames 1 --warmup 0 -o "$tmp/local.exr" -q
+  expect_code 0 && [[ -s $tmp/local.exr ]]; check "render: a .slfc of local directions renders ($err)" $?
+  run info "$tmp/local.slfc"
+  expect_code 0 && [[ $out == *"hemisphere"* ]]; check "info: a local grid is named as views over each texel's hemisphere" $?
   run slf "$tmp/cube.obj" --probe "$forest" --direction-space sideways -o "$tmp/x.slfc" --no-cache -q
   expect_code 2 && [[ $err == *--direction-space* ]]; check "slf: an unknown --direction-space is a usage error naming it" $?
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 -o "$tmp/pt.exr" -q

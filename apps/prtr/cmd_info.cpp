@@ -270,7 +270,10 @@ void print_slf_shape(const prt::SlfShape& b) {
               u(b.rows));
   std::printf("directions  %d x %d (azimuth x polar) %s: %d, x 3 channels = %llu floats per row\n",
               b.grid.azimuth, b.grid.elevation,
-              b.grid.space == prt::SlfDirectionSpace::kView ? "views" : "reflected views",
+              b.grid.space == prt::SlfDirectionSpace::kView ? "views over the sphere"
+              : b.grid.space == prt::SlfDirectionSpace::kReflected
+                  ? "reflected views over the sphere"
+                  : "views over each texel's hemisphere",
               b.grid.directions(), u(b.columns()));
   if (b.first_row == 0 && b.row_count == b.rows)
     std::printf("rows        %llu, all of the matrix\n", u(b.row_count));

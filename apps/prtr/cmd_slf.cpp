@@ -202,10 +202,10 @@ void run(const Options& o, CLI::App*) {
     return;
   }
   std::printf("wrote %s (%s)\n", o.output.c_str(), format_bytes(file_bytes).c_str());
-  std::printf("rows (texels)      %llu of %llu, x %d %sdirections x 3 channels\n",
+  std::printf("rows (texels)      %llu of %llu, x %d %s directions x 3 channels\n",
               static_cast<unsigned long long>(r.slf.bake.row_count),
               static_cast<unsigned long long>(r.slf.bake.rows), r.slf.bake.grid.directions(),
-              r.slf.bake.grid.space == prt::SlfDirectionSpace::kReflected ? "reflected " : "");
+              std::string(prt::kSlfDirectionSpaceNames.name(r.slf.bake.grid.space)).c_str());
   std::printf("data generation    %.2f s%s\n", r.bake_seconds,
               r.bake_cached ? " (read from the cache; the bake itself was earlier)" : "");
   std::printf("compression        %.2f s (K = %d clusters, N = %d components)\n",

@@ -36,14 +36,18 @@ void add_slf_flags(CLI::App* cmd, SlfFlags& f, const char* samples_flag) {
       ->capture_default_str();
   cmd->add_option("--directions", f.directions,
                   "Surface light field: direction grid ZxW, azimuth x polar cells over the "
-                  "sphere (64x32, the SLF paper's glossy grid, sharpens glints at 4x the bake "
+                  "sphere, or each texel's hemisphere with --direction-space local (64x32, the SLF "
+                  "paper's glossy grid, sharpens glints at 4x the bake "
                   "with the same --spp)")
       ->capture_default_str();
   cmd->add_option("--direction-space", f.direction_space,
-                  "Surface light field: what the direction grid holds: the views (the SLF "
-                  "paper's) or their mirror images about the shading normal (reflected, Wood et "
-                  "al. 2000: a glossy lobe and what it reflects sit at one grid place across the "
-                  "surface)")
+                  "Surface light field: what the direction grid holds: the views over the "
+                  "sphere (the SLF paper's), their mirror images about the shading normal "
+                  "(reflected, Wood et al. 2000: a glossy lobe and what it reflects sit at one "
+                  "grid place across the surface), or the views over each texel's hemisphere "
+                  "in its own frame (local: no cell below the horizon, twice the polar "
+                  "resolution; lower error on a smooth sphere's glints, higher on the bunny's "
+                  "and horse's rims, docs/BENCHMARKS.md)")
       ->check(CLI::IsMember(prt::kSlfDirectionSpaceNames.names()))
       ->capture_default_str();
   add_checked_option(cmd, "--spp", f.spp,

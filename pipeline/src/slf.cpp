@@ -81,13 +81,13 @@ SlfRun make_slf(const meshes::Mesh& mesh, const std::string& mesh_path, const pr
     std::snprintf(
         line, sizeof line,
         "slf: %dx%d atlas (%d %s charts), %llu of %llu texels used (%zu triangles); %llu rows x "
-        "%d %sdirections x %d spp, %d bounce(s); %s of radiance",
+        "%d %s directions x %d spp, %d bounce(s); %s of radiance",
         atlas.width, atlas.height, atlas.chart_count, meshes::kAtlasChartsNames.name(atlas.charts),
         static_cast<unsigned long long>(rows),
         static_cast<unsigned long long>(std::uint64_t(atlas.width) * atlas.height),
         mesh.triangles.size(), static_cast<unsigned long long>(count),
         settings.bake.grid.directions(),
-        settings.bake.grid.space == prt::SlfDirectionSpace::kReflected ? "reflected " : "",
+        std::string(prt::kSlfDirectionSpaceNames.name(settings.bake.grid.space)).c_str(),
         settings.bake.spp, settings.bake.bounces,
         common::format_bytes(count * columns * 4).c_str());
     reporter.tell(line);
