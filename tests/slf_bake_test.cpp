@@ -282,25 +282,36 @@ TEST(SlfBake, TheFileRecordsTheDirectionSpace) {
 // bake must hold, cell for cell, what the view bake holds half a turn away (differing by no
 // more than two view bakes of different seeds do), and differ from the view bake at the
 // same cell under a probe that is brighter toward +X.
-TEST(SlfBake, AReflectedGridHoldsTheMirroredViewsRadiance) {
-  const meshes::Mesh plane = meshes::make_plane(2.f, 1);
-  const meshes::Atlas atlas = meshes::make_atlas(plane, 8, 8);
-  const probes::Probe probe = probes::make_from_function(64, 32, [](const Eigen::Vector3d& d) {
-    const float v = float(1.0 + 0.8 * d.x() + 0.3 * d.y());
-    return probes::Rgb(v, 0.5f * v, 0.25f);
-  });
+// A plane facing +Y, its 8 x 8 atlas, a probe brighter toward +X (and toward -Z by
+// `toward_minus_z`), and a glossy Phong bake of it without bounces.
+struct GlossyPlane {
+  meshes::Mesh plane = meshes::make_plane(2.f, 1);
+  meshes::Atlas atlas = meshes::make_atlas(plane, 8, 8);
+  probes::Probe probe;
   prt::SlfBakeOptions o;
+  explicit GlossyPlane(double toward_minus_z) {
+    probe = probes::make_from_function(64, 32, [toward_minus_z](const Eigen::Vector3d& d) {
+      const float v = float(1.0 + 0.8 * d.x() + 0.3 * d.y() - toward_minus_z * d.z());
+      return probes::Rgb(v, 0.5f * v, 0.25f);
+    });
+    o.spp = 128;
+    o.bounces = 0;
+    o.material.kind = prt::MaterialKind::kPhong;
+    o.material.exponent = 8;
+    o.material.specular = 0.6f;
+    o.material.albedo = Eigen::Vector3f::Constant(0.2f);
+  }
+  prt::SlfMatrix bake() const { return prt::bake_slf(plane, atlas, probe, o); }
+};
+
+TEST(SlfBake, AReflectedGridHoldsTheMirroredViewsRadiance) {
+  GlossyPlane p(0.0);
+  prt::SlfBakeOptions& o = p.o;
   o.grid = {8, 4};
-  o.spp = 128;
-  o.bounces = 0;
-  o.material.kind = prt::MaterialKind::kPhong;
-  o.material.exponent = 8;
-  o.material.specular = 0.6f;
-  o.material.albedo = Eigen::Vector3f::Constant(0.2f);
-  const prt::SlfMatrix view = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix view = p.bake();
   o.grid.space = prt::SlfDirectionSpace::kReflected;
   o.seed = 2;
-  const prt::SlfMatrix mirrored = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix mirrored = p.bake();
   ASSERT_EQ(view.data.size(), mirrored.data.size());
   double shifted = 0, same = 0;
   const int z = o.grid.azimuth;
@@ -316,7 +327,7 @@ TEST(SlfBake, AReflectedGridHoldsTheMirroredViewsRadiance) {
         }
   // The two bakes' noise: the view bake again with the reflected one's seed.
   o.grid.space = prt::SlfDirectionSpace::kView;
-  const prt::SlfMatrix view_again = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix view_again = p.bake();
   double noise = 0;
   for (std::size_t k = 0; k < view.data.size(); ++k)
     noise += double(view.data[k] - view_again.data[k]) * double(view.data[k] - view_again.data[k]);
@@ -408,27 +419,16 @@ TEST(SlfDirections, LocalSpaceIsTheViewInTheTexelsFrame) {
 // the sphere, cell for cell: the two bakes must agree there to within two view bakes of
 // different seeds, and differ from the view grid of W rows at the same cell.
 TEST(SlfBake, ALocalGridHoldsTheUpperHalfOfAViewGridOfTwiceTheRows) {
-  const meshes::Mesh plane = meshes::make_plane(2.f, 1);
-  const meshes::Atlas atlas = meshes::make_atlas(plane, 8, 8);
-  const probes::Probe probe = probes::make_from_function(64, 32, [](const Eigen::Vector3d& d) {
-    const float v = float(1.0 + 0.8 * d.x() + 0.3 * d.y() - 0.4 * d.z());
-    return probes::Rgb(v, 0.5f * v, 0.25f);
-  });
-  prt::SlfBakeOptions o;
+  GlossyPlane p(0.4);
+  prt::SlfBakeOptions& o = p.o;
   o.grid = {8, 8};
-  o.spp = 128;
-  o.bounces = 0;
-  o.material.kind = prt::MaterialKind::kPhong;
-  o.material.exponent = 8;
-  o.material.specular = 0.6f;
-  o.material.albedo = Eigen::Vector3f::Constant(0.2f);
-  const prt::SlfMatrix view = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix view = p.bake();
   o.seed = 2;
-  const prt::SlfMatrix view_again = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix view_again = p.bake();
   o.grid = {8, 4, prt::SlfDirectionSpace::kLocal};
-  const prt::SlfMatrix local = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix local = p.bake();
   o.grid = {8, 4};
-  const prt::SlfMatrix coarse = prt::bake_slf(plane, atlas, probe, o);
+  const prt::SlfMatrix coarse = p.bake();
   ASSERT_EQ(local.shape.row_count, view.shape.row_count);
   const std::size_t upper = 3 * 8 * 4;  // floats of the view grid's upper 4 rows
   ASSERT_EQ(local.shape.columns(), upper);
