@@ -88,6 +88,26 @@ TEST(Camera, ProjectsKnownPointsToTheirPixels) {
   }
 }
 
+// The rays a path tracer sends through a pixel pass where the raster samples it: pixel
+// (x, y) spans [x, x + 1] x [y, y + 1] in window coordinates from the top, its centre at
+// + 0.5, and sample (i, j) of n x n at the centre of its sub-pixel (what an n-times
+// supersampled frame rasterises), checked through the projection matrix the GL path uses.
+TEST(Camera, PixelAndSubpixelRaysPassThroughTheRasterisedPositions) {
+  const render::Camera c = oblique_camera();
+  for (const auto& [x, y] : {std::pair{0, 0}, std::pair{17, 203}, std::pair{639, 359}}) {
+    const Eigen::Vector2d centre = pixel_of(c, c.eye + 2.0 * c.pixel_direction(x, y));
+    EXPECT_NEAR(centre.x(), x + 0.5, 1e-9);
+    EXPECT_NEAR(centre.y(), y + 0.5, 1e-9);
+    for (const int n : {1, 3, 8})
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const Eigen::Vector2d p = pixel_of(c, c.eye + 2.0 * c.subpixel_direction(x, y, i, j, n));
+          EXPECT_NEAR(p.x(), x + (i + 0.5) / n, 1e-9) << n;
+          EXPECT_NEAR(p.y(), y + (j + 0.5) / n, 1e-9) << n;
+        }
+  }
+}
+
 TEST(GlmEigen, MatricesAndVectorsCrossElementForElement) {
   Eigen::Matrix4d m;
   for (int i = 0; i < 16; ++i) m(i / 4, i % 4) = i;  // row r, column c holds 4r + c

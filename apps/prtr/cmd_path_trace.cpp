@@ -63,43 +63,57 @@ void run(const Options& o, CLI::App* cmd) {
   options.seed = o.seed;
   const prt::PathTracer tracer(mesh, probe, material, options);
 
+  // Each pixel is integrated over its area, as prtr render's supersampled frames are
+  // box-filtered: the paths are spread over an n x n grid of sub-pixels (n the largest with
+  // n^2 <= spp, at most 8), spp / n^2 paths through each sub-pixel's centre, and the coverage
+  // is the fraction of sub-pixels whose ray meets the mesh.
   const int w = camera.width, h = camera.height;
-  Eigen::Matrix3Xf origins(3, Eigen::Index(w) * h), directions(3, Eigen::Index(w) * h);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const Eigen::Index i = Eigen::Index(y) * w + x;
-      origins.col(i) = camera.eye.cast<float>();
-      directions.col(i) = camera.pixel_direction(x + 0.5, y + 0.5).cast<float>();
-    }
-  }
+  int n = 1;
+  while (n < 8 && (n + 1) * (n + 1) <= o.spp) ++n;
+  const int per_subpixel = o.spp / (n * n), spp = per_subpixel * n * n;
+  const Eigen::Index rays = Eigen::Index(w) * h * n * n;
+  Eigen::Matrix3Xf origins(3, rays), directions(3, rays);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const Eigen::Index r = ((Eigen::Index(y) * w + x) * n + j) * n + i;
+          origins.col(r) = camera.eye.cast<float>();
+          directions.col(r) = camera.subpixel_direction(x, y, i, j, n).cast<float>();
+        }
   ProgressBar bar(o.quiet);
   const auto start = std::chrono::steady_clock::now();
   const Eigen::Matrix3Xf radiance = prt::path_trace_image(
-      tracer, origins, directions, o.spp,
+      tracer, origins, directions, per_subpixel,
       [&bar](std::uint64_t done, std::uint64_t total) { bar.update("path trace", done, total); });
   bar.finish();
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
-  // Coverage: whether the pixel's ray meets the mesh at all.
-  std::vector<prt::RayHit> hits(std::size_t(w) * h);
+  std::vector<prt::RayHit> hits(static_cast<std::size_t>(rays));
   tracer.scene().intersect_from(origins, directions, 0.f, hits.data());
   render::Image image;
   image.width = w;
   image.height = h;
   image.rgba.resize(std::size_t(w) * h * 4);
+  const Eigen::Index subpixels = Eigen::Index(n) * n;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const Eigen::Index i = Eigen::Index(y) * w + x;
+      const Eigen::Index first = (Eigen::Index(y) * w + x) * subpixels;
+      const Eigen::Vector3f mean = radiance.middleCols(first, subpixels).rowwise().mean();
+      int covered = 0;
+      for (Eigen::Index r = first; r < first + subpixels; ++r)
+        covered += hits[std::size_t(r)].triangle >= 0 ? 1 : 0;
       float* p = image.pixel(x, y);
-      for (int c = 0; c < 3; ++c) p[c] = radiance(c, i);
-      p[3] = hits[std::size_t(i)].triangle >= 0 ? 1.f : 0.f;
+      for (int c = 0; c < 3; ++c) p[c] = mean[c];
+      p[3] = float(covered) / float(subpixels);
     }
   }
   render::write_exr(o.output, image);
   if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
-  std::printf("wrote %s: %d x %d, %d paths per pixel, %d bounce(s), %.1f s\n", o.output.c_str(), w,
-              h, o.spp, o.bounces, seconds);
+  std::printf(
+      "wrote %s: %d x %d, %d paths per pixel over %d x %d sub-pixels, %d bounce(s), %.1f s\n",
+      o.output.c_str(), w, h, spp, n, n, o.bounces, seconds);
 }
 
 }  // namespace cmd_path_trace

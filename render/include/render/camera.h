@@ -29,8 +29,14 @@ struct Camera {
   Eigen::Matrix4d view_from_world() const;
   Eigen::Matrix4d clip_from_view() const;
   Eigen::Matrix4d clip_from_world() const { return clip_from_view() * view_from_world(); }
-  // Unit world direction through the centre of pixel (x, y), row 0 at the top.
+  // Unit world direction through the centre of pixel (x, y), row 0 at the top; fractional
+  // (x, y) move off the centre, so pixel (x, y) spans x - 0.5 .. x + 0.5.
   Eigen::Vector3d pixel_direction(double x, double y) const;
+  // Through sample (i, j) of an n x n grid over pixel (x, y), each at the centre of its
+  // sub-pixel: the positions an n-times supersampled frame (render/supersample.h) shades.
+  Eigen::Vector3d subpixel_direction(int x, int y, int i, int j, int n) const {
+    return pixel_direction(x - 0.5 + (i + 0.5) / n, y - 0.5 + (j + 0.5) / n);
+  }
 };
 
 // The default camera: looks down -Z (probe centre behind the object, probes/probe.h) at the
