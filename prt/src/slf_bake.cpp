@@ -282,9 +282,9 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       o.light_samples > 0 ? tracer.sample_lights(point, shared, mix_key(row_key, 0x11647ULL))
                           : SharedLights{};
   const double ratio = lights.size() > 0 ? double(o.light_samples) : 0.0;
-  const Eigen::Vector3d normal = point.frame.col(2);
+  const SlfPointSpace space(o.grid, point.frame.col(2));
   const auto view_at = [&](const GridCell& cell, const Eigen::Vector2d& ab) {
-    return slf_grid_view(o.grid, cell_direction(o.grid, cell, ab.x(), ab.y()), normal);
+    return space.to_view(cell_direction(o.grid, cell, ab.x(), ab.y()));
   };
   for (int column = 0; column < directions; ++column) {
     const GridCell cell(o.grid, column);

@@ -60,30 +60,39 @@ Eigen::Matrix3d slf_local_frame(const Eigen::Vector3d& normal) {
   return frame;
 }
 
+SlfPointSpace::SlfPointSpace(const SlfGrid& grid, const Eigen::Vector3d& normal)
+    : space_(grid.space), normal_(normal), frame_(Eigen::Matrix3d::Identity()) {
+  if (space_ == SlfDirectionSpace::kLocal) frame_ = slf_local_frame(normal);
+}
+
 // Eq. 1's axes put the pole on +Y and azimuth 0 on -Z; the local grid's are the normal and
 // the tangent, so a local direction is (bitangent, normal, -tangent) components.
-Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
-                               const Eigen::Vector3d& normal) {
-  switch (grid.space) {
+Eigen::Vector3d SlfPointSpace::to_grid(const Eigen::Vector3d& view) const {
+  switch (space_) {
     case SlfDirectionSpace::kView:
       return view;
     case SlfDirectionSpace::kReflected:
-      return 2.0 * normal.dot(view) * normal - view;
-    case SlfDirectionSpace::kLocal: {
-      const Eigen::Matrix3d f = slf_local_frame(normal);
-      return {f.col(1).dot(view), f.col(2).dot(view), -f.col(0).dot(view)};
-    }
+      return 2.0 * normal_.dot(view) * normal_ - view;
+    case SlfDirectionSpace::kLocal:
+      return {frame_.col(1).dot(view), frame_.col(2).dot(view), -frame_.col(0).dot(view)};
   }
   return view;
 }
 
+Eigen::Vector3d SlfPointSpace::to_view(const Eigen::Vector3d& grid_direction) const {
+  if (space_ != SlfDirectionSpace::kLocal) return to_grid(grid_direction);  // its own inverse
+  return grid_direction.x() * frame_.col(1) + grid_direction.y() * frame_.col(2) -
+         grid_direction.z() * frame_.col(0);
+}
+
+Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
+                               const Eigen::Vector3d& normal) {
+  return SlfPointSpace(grid, normal).to_grid(view);
+}
+
 Eigen::Vector3d slf_grid_view(const SlfGrid& grid, const Eigen::Vector3d& grid_direction,
                               const Eigen::Vector3d& normal) {
-  if (grid.space != SlfDirectionSpace::kLocal)
-    return slf_grid_space(grid, grid_direction, normal);  // its own inverse
-  const Eigen::Matrix3d f = slf_local_frame(normal);
-  return grid_direction.x() * f.col(1) + grid_direction.y() * f.col(2) -
-         grid_direction.z() * f.col(0);
+  return SlfPointSpace(grid, normal).to_view(grid_direction);
 }
 
 Eigen::Vector2d slf_grid_coordinates(const SlfGrid& grid, const Eigen::Vector3d& grid_direction) {

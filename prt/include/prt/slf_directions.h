@@ -79,6 +79,20 @@ Eigen::Vector3d slf_grid_space(const SlfGrid& grid, const Eigen::Vector3d& view,
 // The inverse: the view a direction in the grid's axes stands for.
 Eigen::Vector3d slf_grid_view(const SlfGrid& grid, const Eigen::Vector3d& grid_direction,
                               const Eigen::Vector3d& normal);
+// The same two maps at one point, its local frame computed once: what the bake uses for the
+// thousands of views it samples at each texel.
+class SlfPointSpace {
+ public:
+  SlfPointSpace(const SlfGrid& grid, const Eigen::Vector3d& normal);
+  Eigen::Vector3d to_grid(const Eigen::Vector3d& view) const;            // slf_grid_space
+  Eigen::Vector3d to_view(const Eigen::Vector3d& grid_direction) const;  // slf_grid_view
+
+ private:
+  SlfDirectionSpace space_;
+  Eigen::Vector3d normal_;
+  Eigen::Matrix3d frame_;  // the local grid's only
+};
+
 // (xi1, xi2) of a direction in the grid's axes, xi2 over the grid's polar span (clamped to 1
 // below the local grid's horizon).
 Eigen::Vector2d slf_grid_coordinates(const SlfGrid& grid, const Eigen::Vector3d& grid_direction);
