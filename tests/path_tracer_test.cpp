@@ -324,4 +324,39 @@ TEST(PathTracer, ResultsDependOnlyOnTheKeys) {
   EXPECT_NE(other, together[3]);
 }
 
+// An image traced in bands, each keyed from its first ray's index in the whole image, is the
+// image traced at once; a ray that misses shows the probe.
+TEST(PathTracer, ImageInBandsIsTheImageAtOnce) {
+  const meshes::Mesh sphere = meshes::make_sphere(1.f, 24, 12);
+  const probes::Probe probe = smooth_probe();
+  prt::Material m;
+  m.kind = prt::MaterialKind::kCookTorrance;
+  m.roughness = 0.2f;
+  const prt::PathTracer tracer(sphere, probe, m);
+  // A fan of rays from (0, 0, 4) toward the -z axis, the outer ones past the sphere.
+  constexpr int kRays = 200;
+  Eigen::Matrix3Xf origins(3, kRays), directions(3, kRays);
+  for (int i = 0; i < kRays; ++i) {
+    origins.col(i) = Eigen::Vector3f(0, 0, 4);
+    const float a = 0.6f * float(i) / kRays;
+    directions.col(i) =
+        Eigen::Vector3f(std::sin(a), 0.1f * std::cos(3.f * a), -std::cos(a)).normalized();
+  }
+  const Eigen::Matrix3Xf whole = prt::path_trace_image(tracer, origins, directions, 8);
+  const int split = 77;
+  const Eigen::Matrix3Xf first =
+      prt::path_trace_image(tracer, origins.leftCols(split), directions.leftCols(split), 8, {}, 0);
+  const Eigen::Matrix3Xf second =
+      prt::path_trace_image(tracer, origins.rightCols(kRays - split),
+                            directions.rightCols(kRays - split), 8, {}, std::uint64_t(split));
+  EXPECT_EQ(first, whole.leftCols(split));
+  EXPECT_EQ(second, whole.rightCols(kRays - split));
+  // Keyed from 0 instead, the second band's paths are other paths.
+  const Eigen::Matrix3Xf unkeyed = prt::path_trace_image(tracer, origins.rightCols(kRays - split),
+                                                         directions.rightCols(kRays - split), 8);
+  EXPECT_NE(unkeyed, whole.rightCols(kRays - split));
+  const Eigen::Vector3f last = directions.col(kRays - 1);
+  EXPECT_EQ(whole.col(kRays - 1), probe.lookup(last.cast<double>()).cast<float>());
+}
+
 }  // namespace

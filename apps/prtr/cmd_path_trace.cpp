@@ -14,9 +14,12 @@
 #include "render/camera.h"
 #include "render/image.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace prtr_app {
 // Named rather than anonymous: a unity build compiles every command in one unit.
@@ -71,44 +74,58 @@ void run(const Options& o, CLI::App* cmd) {
   int n = 1;
   while (n < 8 && (n + 1) * (n + 1) <= o.spp) ++n;
   const int per_subpixel = o.spp / (n * n), spp = per_subpixel * n * n;
-  const Eigen::Index rays = Eigen::Index(w) * h * n * n;
-  Eigen::Matrix3Xf origins(3, rays), directions(3, rays);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int j = 0; j < n; ++j)
-        for (int i = 0; i < n; ++i) {
-          const Eigen::Index r = ((Eigen::Index(y) * w + x) * n + j) * n + i;
-          origins.col(r) = camera.eye.cast<float>();
-          directions.col(r) = camera.subpixel_direction(x, y, i, j, n).cast<float>();
-        }
-  ProgressBar bar(o.quiet);
-  const auto start = std::chrono::steady_clock::now();
-  const Eigen::Matrix3Xf radiance = prt::path_trace_image(
-      tracer, origins, directions, per_subpixel,
-      [&bar](std::uint64_t done, std::uint64_t total) { bar.update("path trace", done, total); });
-  bar.finish();
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const Eigen::Index subpixels = Eigen::Index(n) * n, row_rays = Eigen::Index(w) * subpixels;
+  const std::uint64_t total = std::uint64_t(row_rays) * std::uint64_t(h);
 
-  std::vector<prt::RayHit> hits(static_cast<std::size_t>(rays));
-  tracer.scene().intersect_from(origins, directions, 0.f, hits.data());
+  // The rows are traced in bands of about 2^20 rays (some 60 MB of rays, radiance and hits),
+  // so memory does not grow with the image or the paths a pixel. Each ray's paths keep its
+  // index in the whole image as their key, so the bands do not change a bit of the result.
+  constexpr Eigen::Index kBandRays = Eigen::Index(1) << 20;
+  const int band_rows = int(std::clamp<Eigen::Index>(kBandRays / row_rays, 1, h));
   render::Image image;
   image.width = w;
   image.height = h;
   image.rgba.resize(std::size_t(w) * h * 4);
-  const Eigen::Index subpixels = Eigen::Index(n) * n;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const Eigen::Index first = (Eigen::Index(y) * w + x) * subpixels;
-      const Eigen::Vector3f mean = radiance.middleCols(first, subpixels).rowwise().mean();
-      int covered = 0;
-      for (Eigen::Index r = first; r < first + subpixels; ++r)
-        covered += hits[std::size_t(r)].triangle >= 0 ? 1 : 0;
-      float* p = image.pixel(x, y);
-      for (int c = 0; c < 3; ++c) p[c] = mean[c];
-      p[3] = float(covered) / float(subpixels);
+  ProgressBar bar(o.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  for (int y0 = 0; y0 < h; y0 += band_rows) {
+    const int rows = std::min(band_rows, h - y0);
+    const Eigen::Index rays = row_rays * rows;
+    const std::uint64_t first = std::uint64_t(row_rays) * std::uint64_t(y0);
+    Eigen::Matrix3Xf origins(3, rays), directions(3, rays);
+    origins.colwise() = camera.eye.cast<float>();
+    for (int y = y0; y < y0 + rows; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) {
+            const Eigen::Index r = ((Eigen::Index(y - y0) * w + x) * n + j) * n + i;
+            directions.col(r) = camera.subpixel_direction(x, y, i, j, n).cast<float>();
+          }
+    const Eigen::Matrix3Xf radiance = prt::path_trace_image(
+        tracer, origins, directions, per_subpixel,
+        [&bar, first, total](std::uint64_t done, std::uint64_t) {
+          bar.update("path trace", first + done, total);
+        },
+        first);
+    std::vector<prt::RayHit> hits(static_cast<std::size_t>(rays));
+    tracer.scene().intersect_from(origins, directions, 0.f, hits.data());
+    for (int y = y0; y < y0 + rows; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const Eigen::Index begin = (Eigen::Index(y - y0) * w + x) * subpixels;
+        const Eigen::Vector3f mean = radiance.middleCols(begin, subpixels).rowwise().mean();
+        int covered = 0;
+        for (Eigen::Index r = begin; r < begin + subpixels; ++r)
+          covered += hits[std::size_t(r)].triangle >= 0 ? 1 : 0;
+        float* p = image.pixel(x, y);
+        for (int c = 0; c < 3; ++c) p[c] = mean[c];
+        p[3] = float(covered) / float(subpixels);
+      }
     }
   }
+  bar.finish();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
   render::write_exr(o.output, image);
   if (!o.png.empty()) render::write_png(o.png, image, o.view.exposure);
   std::printf(

@@ -503,9 +503,10 @@ Eigen::Vector3d PathTracer::exit_radiance(const SurfacePoint& point, const Eigen
   return spp > 0 ? Eigen::Vector3d(sum / spp) : sum;
 }
 
-Eigen::Matrix3Xf path_trace_image(
-    const PathTracer& tracer, const Eigen::Matrix3Xf& origins, const Eigen::Matrix3Xf& directions,
-    int spp, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+Eigen::Matrix3Xf path_trace_image(const PathTracer& tracer, const Eigen::Matrix3Xf& origins,
+                                  const Eigen::Matrix3Xf& directions, int spp,
+                                  const std::function<void(std::uint64_t, std::uint64_t)>& progress,
+                                  std::uint64_t first_key) {
   if (origins.cols() != directions.cols()) {
     throw std::invalid_argument("path_trace_image: " + std::to_string(origins.cols()) +
                                 " origins for " + std::to_string(directions.cols()) +
@@ -536,7 +537,8 @@ Eigen::Matrix3Xf path_trace_image(
       const SurfacePoint p = tracer.surface_point(h.triangle, h.u, h.v);
       if (p.face_normal.dot(d) >= 0) continue;  // back face
       for (int k = 0; k < spp; ++k) {
-        queries.push_back(ExitQuery{p, -d, mix_key(std::uint64_t(begin + i), std::uint64_t(k)),
+        queries.push_back(ExitQuery{p, -d,
+                                    mix_key(first_key + std::uint64_t(begin + i), std::uint64_t(k)),
                                     std::uint32_t(i)});
       }
     }

@@ -162,10 +162,13 @@ class PathTracer {
 // A pinhole (or any) image: radiance along each camera ray (origins and unit directions,
 // 3 x pixels), the mean of `spp` paths per pixel. A ray that misses shows the probe; one that
 // hits a back face is black. Parallel over pixels, deterministic for the tracer's seed.
-// `progress` (optional) gets pixels done and total, from one thread at a time.
+// `progress` (optional) gets pixels done and total, from one thread at a time. Ray i's paths
+// are keyed by first_key + i, so an image traced in bands (each band's first_key its first
+// ray's index in the whole image) is the image traced at once, to the bit.
 Eigen::Matrix3Xf path_trace_image(
     const PathTracer& tracer, const Eigen::Matrix3Xf& origins, const Eigen::Matrix3Xf& directions,
-    int spp, const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+    int spp, const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
+    std::uint64_t first_key = 0);
 
 // A counter-based random stream (SplitMix64's finaliser over key and counter, Steele et al.,
 // "Fast splittable pseudorandom number generators", 2014): number i of stream `key` is a
