@@ -457,6 +457,12 @@ if [[ -f $forest ]]; then
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 8 --height 6 --spp 1 -o "$tmp/pt2.exr" -q
   run compare "$tmp/slf.exr" "$tmp/pt2.exr"
   expect_code 1 && [[ $err == *"differ in size"* ]]; check "compare: images of different sizes are refused naming both" $?
+  # A second reference of another seed: its noise is reported and taken out of the error.
+  run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 --seed 9 -o "$tmp/pt9.exr" -q
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --second-reference "$tmp/pt9.exr" --json
+  expect_code 0 && [[ $out == *'"reference_noise":0.'* && $out == *'"corrected_relative_rmse":'* ]]; check "compare: a second reference reports the references' noise and the corrected error" $?
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --second-reference "$tmp/pt2.exr"
+  expect_code 1 && [[ $err == *pt2.exr* && $err == *"differ in size"* ]]; check "compare: a second reference of another size is refused naming it" $?
   # --erode leaves the outline out: fewer pixels, and none at all when the band is wider
   # than the mesh's image.
   run compare "$tmp/slf.exr" "$tmp/pt.exr" --json; all=$(jget - /pixels <<<"$out")
