@@ -461,6 +461,8 @@ if [[ -f $forest ]]; then
   run path-trace "$tmp/cube.obj" --probe "$forest" --width 16 --height 12 --spp 2 --seed 9 -o "$tmp/pt9.exr" -q
   run compare "$tmp/slf.exr" "$tmp/pt.exr" --second-reference "$tmp/pt9.exr" --json
   expect_code 0 && [[ $out == *'"reference_noise":0.'* && $out == *'"corrected_relative_rmse":'* ]]; check "compare: a second reference reports the references' noise and the corrected error" $?
+  run compare "$tmp/slf.exr" "$tmp/pt.exr" --second-reference "$tmp/pt.exr"
+  expect_code 2 && [[ $err == *--second-reference* && $err == *"the reference itself"* ]]; check "compare: the reference as its own second reference is a usage error" $?
   run compare "$tmp/slf.exr" "$tmp/pt.exr" --second-reference "$tmp/pt2.exr"
   expect_code 1 && [[ $err == *pt2.exr* && $err == *"differ in size"* ]]; check "compare: a second reference of another size is refused naming it" $?
   # --erode leaves the outline out: fewer pixels, and none at all when the band is wider

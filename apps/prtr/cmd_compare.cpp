@@ -2,6 +2,7 @@
 // path-trace), over the pixels the mesh covers in both (render/image_difference.h).
 #include "commands.h"
 #include "common/json.h"
+#include "common/output_path.h"
 #include "flag_checks.h"
 
 #include "render/image.h"
@@ -39,8 +40,12 @@ void add_flags(CLI::App* cmd, Options& o) {
 
 void run(const Options& o, CLI::App*) {
   const render::Image image = render::read_image(o.image);
-  const render::Image reference = render::read_image(o.reference);
   const bool second = !o.second_reference.empty();
+  // The same file twice has no difference to measure noise by, and would say there is none.
+  if (second && common::same_file(o.second_reference, o.reference))
+    throw UsageError("--second-reference " + o.second_reference +
+                     " is the reference itself: give the same scene traced with another --seed");
+  const render::Image reference = render::read_image(o.reference);
   const render::Image second_reference =
       second ? render::read_image(o.second_reference) : render::Image{};
   render::ImageDifference d;
