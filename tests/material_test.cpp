@@ -418,6 +418,41 @@ TEST(BrdfEval, Reciprocity) {
   }
 }
 
+// The array form against the scalar one: one direction against 500 others, every material
+// and both masking terms, a coloured material's channels, grazing directions included.
+TEST(BrdfEval, BatchEqualsTheScalarForm) {
+  prt::Pcg32 rng(5);
+  prt::Material smith = cook_torrance(0.1f, 0.3f, 0.5f);
+  smith.masking = prt::Masking::kSmith;
+  prt::Material coloured = smith;
+  coloured.albedo = Eigen::Vector3f(0.7f, 0.2f, 0.4f);
+  for (const prt::Material& m :
+       {make_material(prt::MaterialKind::kLambert, 0.8f, 0.f), phong(1.f), phong(37.5f),
+        cook_torrance(0.05f), cook_torrance(0.3f), smith, coloured}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      Eigen::Vector3d v = prt::sample_uniform_sphere(rng.next_double(), rng.next_double());
+      v.z() = std::max(std::abs(v.z()), 1e-3);
+      v.normalize();
+      Eigen::Matrix3Xd s(3, 500);
+      for (Eigen::Index i = 0; i < s.cols(); ++i) {
+        Eigen::Vector3d d = prt::sample_uniform_sphere(rng.next_double(), rng.next_double());
+        d.z() = std::max(std::abs(d.z()), i % 50 == 0 ? 1e-3 : 1e-9);
+        s.col(i) = d.normalized();
+      }
+      for (int channel = 0; channel < 3; ++channel) {
+        const Eigen::ArrayXd batch = prt::brdf_eval_batch(m, channel, v, s);
+        ASSERT_EQ(batch.size(), s.cols());
+        for (Eigen::Index i = 0; i < s.cols(); ++i) {
+          const double scalar = prt::brdf_eval(m, channel, v, s.col(i));
+          ASSERT_NEAR(batch[i], scalar, 1e-9 * std::max(1.0, std::abs(scalar)))
+              << prt::kMaterialNames.name(m.kind) << " channel " << channel
+              << " s=" << s.col(i).transpose();
+        }
+      }
+    }
+  }
+}
+
 TEST(BrdfEval, DirectionalAlbedoAtMostOne) {
   // int f_r(v, s) s.z ds of prt::brdf_eval for rho_d + rho_s = 1 (library_albedo). The
   // quadrature's error

@@ -160,7 +160,7 @@ TEST(PathTracer, MisEstimateMatchesADenseQuadrature) {
 }
 
 // The surface light field's estimator: the light technique from samples shared by many
-// views (shared_light_sum) and the paths' BRDF technique weighted for them (ExitQuery's
+// views (add_shared_light) and the paths' BRDF technique weighted for them (ExitQuery's
 // shared_light_ratio) together estimate the same integral, for several sharing ratios.
 TEST(PathTracer, SharedLightSamplesMatchADenseQuadrature) {
   const QuadratureCase q;
@@ -175,13 +175,10 @@ TEST(PathTracer, SharedLightSamplesMatchADenseQuadrature) {
     for (int ratio : {1, 4}) {
       const prt::SharedLights lights = tracer.sample_lights(p, kPaths * ratio, 77);
       ASSERT_EQ(lights.size(), std::size_t(kPaths * ratio));
-      const std::vector<Eigen::Vector3d> views(lights.size(), q.view);
-      std::vector<std::uint32_t> lights_of(lights.size());
-      for (std::size_t i = 0; i < lights.size(); ++i)
-        lights_of[i] = std::uint32_t((i + 3) % lights.size());
-      const Eigen::Vector3d light_part =
-          tracer.shared_light_sum(p, lights, views, lights_of, double(ratio)) /
-          double(lights.size());
+      Eigen::Vector3d light_part = Eigen::Vector3d::Zero();
+      for (std::size_t j = 0; j < lights.size(); ++j)
+        tracer.add_shared_light(p, lights, j, q.view, double(ratio), &light_part);
+      light_part /= double(lights.size());
       std::vector<prt::ExitQuery> queries;
       for (int k = 0; k < kPaths; ++k) {
         prt::ExitQuery e{p, q.view, std::uint64_t(k), 0};

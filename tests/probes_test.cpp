@@ -354,6 +354,22 @@ TEST(Lookup, SmoothFunctionWithinInterpolationError) {
   EXPECT_NEAR(p.lookup({0, -1, 0}).x(), 1.0, bound);
 }
 
+// A caller that has a direction's lat-long coordinates (the path tracer's escaping rays)
+// reads the same radiance from them; coordinates that are not finite are refused by name.
+TEST(Lookup, AtCoordinatesIsTheLookupOfTheDirection) {
+  const Probe p = make_from_function(64, 32, [](const Eigen::Vector3d& d) {
+    return Rgb(float(d.x() + 2), float(d.y() * d.z() + 1), float(d.z() + 3));
+  });
+  std::mt19937 rng(4);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d d = random_direction(rng);
+    EXPECT_EQ(p.lookup_uv(probes::latlong_uv(d)), p.lookup(d));
+  }
+  EXPECT_EQ(p.lookup_uv(probes::latlong_uv({0, 1, 0})), p.lookup({0, 1, 0}));
+  EXPECT_THROW(p.lookup_uv(Eigen::Vector2d(std::nan(""), 0.5)), probes::ProbeError);
+  EXPECT_THROW(Probe().lookup_uv(Eigen::Vector2d(0.5, 0.5)), probes::ProbeError);
+}
+
 TEST(Lookup, SmoothFunctionOfAzimuth) {
   // f(d) = d.x + 2 d.y + 3 varies in u too, across the seam. Tensor-product linear
   // interpolation errs by at most (hu^2 max|f_uu| + hv^2 max|f_vv|) / 8 with hu = 1/W,

@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <random>
 
 namespace {
@@ -337,6 +338,18 @@ TEST(SlfBake, AReflectedGridHoldsTheMirroredViewsRadiance) {
 
 // Reflection about the normal is its own inverse and keeps the angle to the normal, so a
 // cell's views are as far from the horizon as the cell; a grid of views is the identity.
+// The bake's cell samples take the polar angle by its cosine: the same direction as Eq. 1 at
+// xi2 = acos(c) / pi, poles and equator included.
+TEST(SlfDirections, DirectionAtACosineIsEquationOne) {
+  for (double xi1 : {0.0, 0.3, 1.0, 1.7, 1.999})
+    for (double c : {1.0, 0.9, 0.31, 0.0, -0.5, -0.999, -1.0}) {
+      const Eigen::Vector3d expected = prt::slf_direction(xi1, std::acos(c) / std::numbers::pi);
+      const Eigen::Vector3d d = prt::slf_direction_at_cosine(xi1, c);
+      EXPECT_LT((d - expected).norm(), 1e-15) << xi1 << " " << c;
+      EXPECT_NEAR(d.norm(), 1.0, 1e-15);
+    }
+}
+
 TEST(SlfDirections, ReflectedSpaceMirrorsAboutTheNormal) {
   std::mt19937 rng(5);
   std::normal_distribution<double> g;

@@ -106,7 +106,12 @@ double Probe::pixel_solid_angle(int y) const {
 
 Rgb Probe::lookup(const Eigen::Vector3d& direction) const {
   check_lookup(name_, rgb_.empty(), direction);
-  const Eigen::Vector2d uv = latlong_uv(direction);
+  return lookup_uv(latlong_uv(direction));
+}
+
+Rgb Probe::lookup_uv(const Eigen::Vector2d& uv) const {
+  if (rgb_.empty() || !uv.allFinite())
+    check_lookup(name_, rgb_.empty(), Eigen::Vector3d(uv.x(), uv.y(), 0.0));  // throws
   // Continuous pixel coordinates whose integers are pixel centres.
   const double fx = uv.x() * width_ - 0.5;
   const double fy = uv.y() * height_ - 0.5;

@@ -250,6 +250,21 @@ double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v
   return eval(make_lobe(material, channel), v, s);
 }
 
+Eigen::ArrayXd brdf_eval_batch(const Material& material, int channel, const Eigen::Vector3d& v,
+                               const Eigen::Matrix3Xd& s) {
+  const Lobe lobe = make_lobe(material, channel);
+  LightArrays arrays{s.row(0).transpose().array(),
+                     s.row(1).transpose().array(),
+                     s.row(2).transpose().array(),
+                     s.row(2).transpose().array().inverse(),
+                     {}};
+  if (lobe.kind == MaterialKind::kCookTorrance && lobe.masking == Masking::kSmith)
+    arrays.smith = arrays.z.unaryExpr([&](double z) { return 1.0 + smith_lambda(z, lobe.m2); });
+  Eigen::ArrayXd out(s.cols());
+  eval_row(lobe, v, arrays, out.data());
+  return out;
+}
+
 BrdfQuadrature resolve_brdf_quadrature(const Material& material, int order,
                                        const BrdfQuadrature& quadrature) {
   check_order(order, "BRDF matrix order");

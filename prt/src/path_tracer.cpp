@@ -37,10 +37,13 @@ Eigen::Vector3d perpendicular(const Eigen::Vector3d& n) {
   return (axis - axis.dot(n) * n).normalized();
 }
 
-// The local view the BRDF is evaluated at: clamp_to_horizon, then lifted to kGrazingZ.
+// The local view the BRDF is evaluated at: below kGrazingZ, the horizon's direction under
+// or over v (clamp_to_horizon of its tangent part) lifted to kGrazingZ, a unit vector. (Lifting
+// v itself where 0 <= v.z < kGrazingZ left it up to 5e-7 short of unit, which the batched
+// BRDF, taking |v + s|^2 = 2 (1 + v.s), turns into percent errors for a light opposite v.)
 Eigen::Vector3d shading_view(const Eigen::Vector3d& v) {
   if (v.z() >= kGrazingZ) return v;
-  const Eigen::Vector3d h = clamp_to_horizon(v);
+  const Eigen::Vector3d h = clamp_to_horizon(Eigen::Vector3d(v.x(), v.y(), -1.0));
   const double t = std::sqrt(1 - kGrazingZ * kGrazingZ);
   return Eigen::Vector3d(t * h.x(), t * h.y(), kGrazingZ);
 }
@@ -93,6 +96,28 @@ struct Lobes {
     double p = (1 - p_spec) * std::max(0.0, s.z()) / kTracerPi;
     if (p_spec > 0) p += p_spec * specular_pdf(v, s);
     return p;
+  }
+
+  // pdf(v_i, s) for the views v_i (columns, v_i.z > 0) against one s with s.z > 0, on
+  // arrays. Cook-Torrance without normalising h, as brdf_eval_batch: with q = 1 + v.s and
+  // p = v.z + s.z, v.h = sqrt(q / 2), h.z = p / sqrt(2q) and 1 / h.z^2 = u = 2q / p^2, so
+  // D h.z / (4 v.h) = D p / (4q); both of h.z and v.h are positive here.
+  Eigen::ArrayXd pdf_batch(const Eigen::Matrix3Xd& views, const Eigen::Vector3d& s) const {
+    const Eigen::ArrayXd vz = views.row(2).transpose().array();
+    Eigen::ArrayXd p = Eigen::ArrayXd::Constant(views.cols(), (1 - p_spec) * s.z() / kTracerPi);
+    if (!(p_spec > 0)) return p;
+    const Eigen::ArrayXd vs = (views.transpose() * s).array();
+    if (material.kind == MaterialKind::kPhong) {
+      // The mirror image of v against s: r.s = 2 v.z s.z - v.s.
+      const Eigen::ArrayXd c = 2 * s.z() * vz - vs;
+      const double e = material.exponent;
+      return p + p_spec * (e + 1) / (2 * kTracerPi) *
+                     (c > 0).select((e * c.max(1e-300).log()).exp(), 0.0);
+    }
+    const Eigen::ArrayXd q = 1 + vs, sum_z = vz + s.z();
+    const Eigen::ArrayXd u = 2 * q / sum_z.square();
+    const Eigen::ArrayXd d = ((1 - u) / m2).exp() * u.square() / (kTracerPi * m2);
+    return p + p_spec * d * sum_z / (4 * q);
   }
 
   // A direction (over the whole sphere; those below the horizon carry nothing) and its
@@ -226,7 +251,11 @@ Eigen::Vector3d ProbeSampler::sample(double u0, double u1, double u2, double u3,
 
 double ProbeSampler::pdf(const Eigen::Vector3d& direction) const {
   if (total_ <= 0) return 0;
-  const Eigen::Vector2d uv = probes::latlong_uv(direction);
+  return pdf_uv(probes::latlong_uv(direction));
+}
+
+double ProbeSampler::pdf_uv(const Eigen::Vector2d& uv) const {
+  if (total_ <= 0) return 0;
   const int x = std::clamp(int(uv.x() * width_), 0, width_ - 1);
   const int y = std::clamp(int(uv.y() * height_), 0, height_ - 1);
   return texel_pdf_[std::size_t(y) * width_ + x];
@@ -313,6 +342,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
   Eigen::Matrix3Xf light_origins, light_dirs, brdf_origins, brdf_dirs;
   std::vector<Eigen::Vector3d> light_value, brdf_value, brdf_through;
   std::vector<Eigen::Vector3d> brdf_world;
+  std::vector<Eigen::Vector2d> brdf_uv;
   std::vector<std::uint32_t> light_path, brdf_path;
   std::vector<std::uint8_t> blocked;
   std::vector<RayHit> hits;
@@ -327,6 +357,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
     brdf_value.clear();
     brdf_through.clear();
     brdf_world.clear();
+    brdf_uv.clear();
     light_path.clear();
     brdf_path.clear();
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -365,9 +396,13 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
       const Eigen::Vector3d s_world = (frame * s).normalized();
       const Eigen::Index k = Eigen::Index(brdf_path.size());
       brdf_through.push_back(path.throughput.cwiseProduct(f) * (s.z() / p_brdf));
-      const double w = lights ? power_weight(p_brdf, light_n * sampler_.pdf(s_world)) : 1.0;
+      // Its probe coordinates serve the light technique's density here and the probe's
+      // radiance if it escapes.
+      const Eigen::Vector2d uv = probes::latlong_uv(s_world);
+      const double w = lights ? power_weight(p_brdf, light_n * sampler_.pdf_uv(uv)) : 1.0;
       brdf_value.push_back(brdf_through.back() * w);
       brdf_world.push_back(s_world);
+      brdf_uv.push_back(uv);
       brdf_dirs.col(k) = s_world.cast<float>();
       brdf_origins.col(k) = ray_origin(path.point, s_world, offset_);
       brdf_path.push_back(i);
@@ -392,7 +427,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
                             blocked.data());
       for (Eigen::Index k = 0; k < brdf_n; ++k) {
         if (blocked[std::size_t(k)]) continue;
-        const Eigen::Vector3d le = probe_.lookup(brdf_world[std::size_t(k)]).cast<double>();
+        const Eigen::Vector3d le = probe_.lookup_uv(brdf_uv[std::size_t(k)]).cast<double>();
         out[paths[brdf_path[std::size_t(k)]].slot] += brdf_value[std::size_t(k)].cwiseProduct(le);
       }
     } else if (brdf_n > 0) {
@@ -404,7 +439,7 @@ void PathTracer::trace(std::vector<Path>& paths, Eigen::Vector3d* out) const {
         const Path& from = paths[brdf_path[std::size_t(k)]];
         const Eigen::Vector3d& d = brdf_world[std::size_t(k)];
         if (h.triangle < 0) {
-          const Eigen::Vector3d le = probe_.lookup(d).cast<double>();
+          const Eigen::Vector3d le = probe_.lookup_uv(brdf_uv[std::size_t(k)]).cast<double>();
           out[from.slot] += brdf_value[std::size_t(k)].cwiseProduct(le);
           continue;
         }
@@ -458,21 +493,32 @@ SharedLights PathTracer::sample_lights(const SurfacePoint& point, int count,
   return lights;
 }
 
-Eigen::Vector3d PathTracer::shared_light_sum(const SurfacePoint& point, const SharedLights& lights,
-                                             const std::vector<Eigen::Vector3d>& views,
-                                             const std::vector<std::uint32_t>& lights_of,
-                                             double ratio) const {
+void PathTracer::add_shared_light(const SurfacePoint& point, const SharedLights& lights,
+                                  std::size_t j, const Eigen::Matrix3Xd& views, double ratio,
+                                  Eigen::Vector3d* out) const {
   const Lobes lobes(material_);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  if (lobes.black) return sum;
-  for (std::size_t i = 0; i < views.size(); ++i) {
-    const std::size_t j = lights_of[i];
-    if (!lights.lit(j)) continue;
-    const Eigen::Vector3d v = shading_view(point.frame.transpose() * views[i]);
-    sum +=
-        light_sample_value(lobes, v, lights.direction[j], lights.radiance[j], lights.pdf[j], ratio);
+  if (lobes.black || !lights.lit(j) || views.cols() == 0) return;
+  const Eigen::Vector3d& s = lights.direction[j];
+  Eigen::Matrix3Xd local = point.frame.transpose() * views;
+  for (Eigen::Index i = 0; i < local.cols(); ++i) local.col(i) = shading_view(local.col(i));
+  // f(v_i, s) as f(s, v_i), and the BRDF technique's density of s from each view.
+  const Eigen::ArrayXd f = brdf_eval_batch(material_, 0, s, local);
+  const Eigen::ArrayXd p_brdf = lobes.pdf_batch(local, s);
+  const double p_light = ratio * lights.pdf[j];
+  const Eigen::ArrayXd w = p_light * p_light / (p_light * p_light + p_brdf.square());
+  const Eigen::ArrayXd scale = w * (s.z() / lights.pdf[j]);
+  const Eigen::Vector3d& radiance = lights.radiance[j];
+  // A coloured material differs from channel 0 in its diffuse term only (Lobes::eval).
+  const Eigen::Vector3d diffuse_offset =
+      material_.grey() ? Eigen::Vector3d::Zero()
+                       : Eigen::Vector3d((material_.albedo.cast<double>().array() -
+                                          double(material_.albedo.x())) /
+                                         kTracerPi);
+  for (Eigen::Index i = 0; i < local.cols(); ++i) {
+    const Eigen::Vector3d fi = Eigen::Vector3d::Constant(f[i]) + diffuse_offset;
+    if (!(fi.maxCoeff() > 0)) continue;  // where the BRDF is zero, as light_sample_value
+    out[i] += fi.cwiseProduct(radiance) * scale[i];
   }
-  return sum;
 }
 
 void PathTracer::add_exit_radiance(const std::vector<ExitQuery>& queries,

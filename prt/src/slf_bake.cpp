@@ -19,7 +19,6 @@
 #include <cmath>
 #include <cstring>
 #include <mutex>
-#include <numbers>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -28,7 +27,6 @@ namespace prt {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kSlfPi = std::numbers::pi;
 
 constexpr common::VersionedFormat kSlfFormat{"surface light field file",
                                              ".slf file written by prtr slf",
@@ -253,7 +251,7 @@ struct GridCell {
 // cosine of the polar angle linear in b, so uniform in solid angle inside the cell.
 Eigen::Vector3d cell_direction(const SlfGrid& grid, const GridCell& cell, double a, double b) {
   const double cos_polar = std::clamp(cell.top + b * (cell.bottom - cell.top), -1.0, 1.0);
-  return slf_direction(2 * (cell.i + a) / grid.azimuth, std::acos(cos_polar) / kSlfPi);
+  return slf_direction_at_cosine(2 * (cell.i + a) / grid.azimuth, cos_polar);
 }
 
 // The texel's samples: the mean radiance over each cell of the grid, from spp paths a cell
@@ -272,9 +270,12 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       tracer.surface_point(atlas.texel_triangle[texel], atlas.texel_barycentric[texel].x(),
                            atlas.texel_barycentric[texel].y());
   thread_local std::vector<ExitQuery> queries;
-  thread_local std::vector<Eigen::Vector3d> sums, views;
-  thread_local std::vector<std::uint32_t> lights_of;
+  thread_local std::vector<Eigen::Vector3d> sums, light_sums;
+  thread_local std::vector<std::uint32_t> shift_x, shift_y;
+  thread_local Eigen::Matrix3Xd views;
+  thread_local std::vector<GridCell> cells;
   queries.clear();
+  cells.clear();
   sums.assign(std::size_t(directions), Eigen::Vector3d::Zero());
   const std::uint64_t row_key = mix_key(o.seed ^ 0x51F0000000000000ULL, row);
   const int shared = o.light_samples * o.spp;
@@ -286,8 +287,10 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
   const auto view_at = [&](const GridCell& cell, const Eigen::Vector2d& ab) {
     return space.to_view(cell_direction(o.grid, cell, ab.x(), ab.y()));
   };
+  shift_x.resize(std::size_t(directions));
+  shift_y.resize(std::size_t(directions));
   for (int column = 0; column < directions; ++column) {
-    const GridCell cell(o.grid, column);
+    const GridCell& cell = cells.emplace_back(o.grid, column);
     const std::uint64_t column_key = mix_key(row_key, std::uint64_t(column));
     for (int k = 0; k < o.spp; ++k) {
       const std::uint64_t key = mix_key(column_key, std::uint64_t(k));
@@ -297,28 +300,31 @@ void bake_row(const PathTracer& tracer, const meshes::Atlas& atlas, std::uint32_
       q.shared_light_ratio = ratio;
       queries.push_back(q);
     }
-    if (ratio > 0) {
-      // Light sample l is paired with view l of a digitally shifted (0, 2)-sequence over the
-      // cell. The probe's samples are stratified along its CDF, so a bright source (a sun)
-      // takes a run of consecutive l, and the sequence spreads any such run over the whole
-      // cell; pairing sample l with stratum l plus a random rotation gave the run a strip of
-      // the cell, a quarter of its polar range for 64 samples. Each view is uniform over the
-      // cell and drawn apart from its light sample, so the sum stays unbiased. Unlit samples
-      // need no view.
-      RandomStream jitter{mix_key(column_key, 0x11647ULL), 0};
-      const auto shift_x = std::uint32_t(jitter.next() * 0x1.0p32);
-      const auto shift_y = std::uint32_t(jitter.next() * 0x1.0p32);
-      views.clear();
-      lights_of.clear();
-      for (std::uint32_t l = 0; l < std::uint32_t(shared); ++l) {
-        if (!lights.lit(l)) continue;
-        const Eigen::Vector2d ab = sobol02(l, shift_x, shift_y);
-        views.push_back(view_at(cell, ab));
-        lights_of.push_back(l);
-      }
-      sums[std::size_t(column)] +=
-          tracer.shared_light_sum(point, lights, views, lights_of, ratio) / o.light_samples;
+    RandomStream jitter{mix_key(column_key, 0x11647ULL), 0};
+    shift_x[std::size_t(column)] = std::uint32_t(jitter.next() * 0x1.0p32);
+    shift_y[std::size_t(column)] = std::uint32_t(jitter.next() * 0x1.0p32);
+  }
+  if (ratio > 0) {
+    // Light sample l is paired, in every cell, with view l of a digitally shifted
+    // (0, 2)-sequence over the cell (each cell its own random shift). The probe's samples are
+    // stratified along its CDF, so a bright source (a sun) takes a run of consecutive l, and
+    // the sequence spreads any such run over the whole cell; pairing sample l with stratum l
+    // plus a random rotation gave the run a strip of the cell, a quarter of its polar range
+    // for 64 samples. Each view is uniform over the cell and drawn apart from its light
+    // sample, so the sum stays unbiased. Unlit samples need no view. One light at a time
+    // against its view in every cell, so that the BRDF runs on arrays.
+    light_sums.assign(std::size_t(directions), Eigen::Vector3d::Zero());
+    views.resize(3, directions);
+    for (std::uint32_t l = 0; l < std::uint32_t(shared); ++l) {
+      if (!lights.lit(l)) continue;
+      for (int column = 0; column < directions; ++column)
+        views.col(column) =
+            view_at(cells[std::size_t(column)],
+                    sobol02(l, shift_x[std::size_t(column)], shift_y[std::size_t(column)]));
+      tracer.add_shared_light(point, lights, l, views, ratio, light_sums.data());
     }
+    for (int column = 0; column < directions; ++column)
+      sums[std::size_t(column)] += light_sums[std::size_t(column)] / o.light_samples;
   }
   tracer.add_exit_radiance(queries, sums.data());
   for (int column = 0; column < directions; ++column) {

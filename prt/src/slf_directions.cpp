@@ -25,6 +25,12 @@ Eigen::Vector3d slf_direction(double xi1, double xi2) {
   return {std::sin(phi) * std::sin(theta), std::cos(phi), -std::sin(phi) * std::cos(theta)};
 }
 
+Eigen::Vector3d slf_direction_at_cosine(double xi1, double cos_polar) {
+  const double theta = M_PI * (xi1 - 1.0);
+  const double sin_polar = std::sqrt(std::max(0.0, 1.0 - cos_polar * cos_polar));
+  return {sin_polar * std::sin(theta), cos_polar, -sin_polar * std::cos(theta)};
+}
+
 Eigen::Vector2d slf_coordinates(const Eigen::Vector3d& direction) {
   const double n = direction.norm();
   if (!(n > 0.0)) return {1.0, 0.5};

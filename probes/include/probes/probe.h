@@ -57,6 +57,8 @@ class Probe {
   double pixel_solid_angle(int y) const;
   // Bilinear radiance lookup between pixel centres; wraps in u, clamps in v.
   Rgb lookup(const Eigen::Vector3d& direction) const;
+  // The same at lat-long coordinates uv = latlong_uv(direction), for a caller that has them.
+  Rgb lookup_uv(const Eigen::Vector2d& uv) const;
   // Nearest-pixel lookup, for tests and previews.
   Rgb lookup_nearest(const Eigen::Vector3d& direction) const;
 

@@ -64,6 +64,13 @@ inline constexpr auto kMaskingNames = common::enum_table<Masking>(
 double brdf_eval(const Material& material, int channel, const Eigen::Vector3d& v,
                  const Eigen::Vector3d& s);
 
+// brdf_eval(material, channel, v, s_i) for every column s_i of `s` at once, on Eigen arrays
+// so that exp and pow run as packets (equal to brdf_eval to rounding). The caller
+// guarantees v.z > 0 and s_i.z > 0 (where brdf_eval would return 0). By reciprocity this is
+// also f_r(s_i, v): one light direction against many views.
+Eigen::ArrayXd brdf_eval_batch(const Material& material, int channel, const Eigen::Vector3d& v,
+                               const Eigen::Matrix3Xd& s);
+
 struct BrdfQuadrature {
   // Gauss-Legendre nodes in cos(theta) x uniform nodes in phi, for the view (v) and light (s)
   // hemispheres. 0 = chosen from the material (sharper lobes get finer s grids).

@@ -60,6 +60,8 @@ class ProbeSampler {
   // A direction from four uniform numbers in [0, 1), and its density per steradian.
   Eigen::Vector3d sample(double u0, double u1, double u2, double u3, double* pdf) const;
   double pdf(const Eigen::Vector3d& direction) const;
+  // The same at lat-long coordinates uv = probes::latlong_uv(direction).
+  double pdf_uv(const Eigen::Vector2d& uv) const;
 
  private:
   int width_ = 0, height_ = 0;
@@ -93,7 +95,7 @@ struct SharedLights {
 // One radiance sample to take: leaving `point` toward the world direction `view` (unit),
 // with random numbers keyed by `key`; its value is added to slot `slot` of the output.
 // With `shared_light_ratio` > 0 the caller estimates the first vertex's light technique
-// itself from shared samples (PathTracer::shared_light_sum), that many per such query: the
+// itself from shared samples (PathTracer::add_shared_light), that many per such query: the
 // path then takes no probe sample there and weights its BRDF sample for that many (Veach's
 // multi-sample model).
 struct ExitQuery {
@@ -127,15 +129,14 @@ class PathTracer {
   // its first number in [j, j + 1) / count), with one shadow ray each, keyed by `key`.
   SharedLights sample_lights(const SurfacePoint& point, int count, std::uint64_t key) const;
 
-  // The light technique at `point` from shared samples for many views: the sum over pairs i
-  // of w f(v_i, s_j) L_j cos_j / p_j, j = lights_of[i], each weighted by the power heuristic
-  // against the BRDF technique for `ratio` light samples per BRDF sample (the ExitQuery's
-  // shared_light_ratio). Views are world-space unit vectors, below-horizon ones clamped as
-  // the paths clamp them. Pairs with unlit samples add nothing and may be left out. Not
-  // divided by the number of pairs.
-  Eigen::Vector3d shared_light_sum(const SurfacePoint& point, const SharedLights& lights,
-                                   const std::vector<Eigen::Vector3d>& views,
-                                   const std::vector<std::uint32_t>& lights_of, double ratio) const;
+  // The light technique at `point` of shared sample j toward many views: adds to out[i]
+  // w f(v_i, s_j) L_j cos_j / p_j for view i (column i of `views`, a world-space unit vector;
+  // below-horizon views are clamped as the paths clamp them), weighted by the power
+  // heuristic against the BRDF technique for `ratio` light samples per BRDF sample (the
+  // ExitQuery's shared_light_ratio). An unlit sample adds nothing. One light against many
+  // views at a time, so that the BRDF and its density run on arrays (brdf_eval_batch).
+  void add_shared_light(const SurfacePoint& point, const SharedLights& lights, std::size_t j,
+                        const Eigen::Matrix3Xd& views, double ratio, Eigen::Vector3d* out) const;
 
   // The mean of `spp` samples of the radiance leaving `point` toward `view`.
   Eigen::Vector3d exit_radiance(const SurfacePoint& point, const Eigen::Vector3d& view, int spp,

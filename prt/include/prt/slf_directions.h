@@ -55,6 +55,9 @@ struct SlfGrid {
 
 // Eq. 1: the unit direction at lat-long coordinates (xi1, xi2).
 Eigen::Vector3d slf_direction(double xi1, double xi2);
+// The same with the polar angle given by its cosine, cos(pi xi2): no acos and cos back for
+// a caller that samples the cosine (a cell uniform in solid angle).
+Eigen::Vector3d slf_direction_at_cosine(double xi1, double cos_polar);
 // Eq. 2: (xi1, xi2) of a direction (need not be unit; zero gives (1, 0.5)).
 Eigen::Vector2d slf_coordinates(const Eigen::Vector3d& direction);
 // The centre of column j Z + i, in the grid's axes.
