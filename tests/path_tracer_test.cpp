@@ -339,7 +339,16 @@ TEST(PathTracer, ImageInBandsIsTheImageAtOnce) {
     directions.col(i) =
         Eigen::Vector3f(std::sin(a), 0.1f * std::cos(3.f * a), -std::cos(a)).normalized();
   }
-  const Eigen::Matrix3Xf whole = prt::path_trace_image(tracer, origins, directions, 8);
+  std::vector<std::uint8_t> hit(kRays, 2);
+  const Eigen::Matrix3Xf whole =
+      prt::path_trace_image(tracer, origins, directions, 8, {}, 0, hit.data());
+  // The coverage it reports is the scene's own intersection of the same rays.
+  std::vector<prt::RayHit> hits(kRays);
+  tracer.scene().intersect_from(origins, directions, 0.f, hits.data());
+  for (int i = 0; i < kRays; ++i)
+    EXPECT_EQ(hit[std::size_t(i)], hits[std::size_t(i)].triangle >= 0 ? 1 : 0) << i;
+  EXPECT_EQ(hit.front(), 1);
+  EXPECT_EQ(hit.back(), 0);
   const int split = 77;
   const Eigen::Matrix3Xf first =
       prt::path_trace_image(tracer, origins.leftCols(split), directions.leftCols(split), 8, {}, 0);

@@ -77,7 +77,7 @@ void run(const Options& o, CLI::App* cmd) {
   const Eigen::Index subpixels = Eigen::Index(n) * n, row_rays = Eigen::Index(w) * subpixels;
   const std::uint64_t total = std::uint64_t(row_rays) * std::uint64_t(h);
 
-  // The rows are traced in bands of about 2^20 rays (some 60 MB of rays, radiance and hits),
+  // The rows are traced in bands of about 2^20 rays (some 40 MB of rays and radiance),
   // so memory does not grow with the image or the paths a pixel. Each ray's paths keep its
   // index in the whole image as their key, so the bands do not change a bit of the result.
   constexpr Eigen::Index kBandRays = Eigen::Index(1) << 20;
@@ -101,21 +101,19 @@ void run(const Options& o, CLI::App* cmd) {
             const Eigen::Index r = ((Eigen::Index(y - y0) * w + x) * n + j) * n + i;
             directions.col(r) = camera.subpixel_direction(x, y, i, j, n).cast<float>();
           }
+    std::vector<std::uint8_t> hit(static_cast<std::size_t>(rays));
     const Eigen::Matrix3Xf radiance = prt::path_trace_image(
         tracer, origins, directions, per_subpixel,
         [&bar, first, total](std::uint64_t done, std::uint64_t) {
           bar.update("path trace", first + done, total);
         },
-        first);
-    std::vector<prt::RayHit> hits(static_cast<std::size_t>(rays));
-    tracer.scene().intersect_from(origins, directions, 0.f, hits.data());
+        first, hit.data());
     for (int y = y0; y < y0 + rows; ++y) {
       for (int x = 0; x < w; ++x) {
         const Eigen::Index begin = (Eigen::Index(y - y0) * w + x) * subpixels;
         const Eigen::Vector3f mean = radiance.middleCols(begin, subpixels).rowwise().mean();
         int covered = 0;
-        for (Eigen::Index r = begin; r < begin + subpixels; ++r)
-          covered += hits[std::size_t(r)].triangle >= 0 ? 1 : 0;
+        for (Eigen::Index r = begin; r < begin + subpixels; ++r) covered += hit[std::size_t(r)];
         float* p = image.pixel(x, y);
         for (int c = 0; c < 3; ++c) p[c] = mean[c];
         p[3] = float(covered) / float(subpixels);

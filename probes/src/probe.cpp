@@ -110,8 +110,13 @@ Rgb Probe::lookup(const Eigen::Vector3d& direction) const {
 }
 
 Rgb Probe::lookup_uv(const Eigen::Vector2d& uv) const {
-  if (rgb_.empty() || !uv.allFinite())
-    check_lookup(name_, rgb_.empty(), Eigen::Vector3d(uv.x(), uv.y(), 0.0));  // throws
+  if (rgb_.empty()) throw ProbeError(describe(name_) + ": lookup in an empty probe");
+  if (!uv.allFinite()) {
+    std::ostringstream msg;
+    msg << describe(name_) << ": lookup at non-finite lat-long coordinates (" << uv.x() << ", "
+        << uv.y() << ")";
+    throw ProbeError(msg.str());
+  }
   // Continuous pixel coordinates whose integers are pixel centres.
   const double fx = uv.x() * width_ - 0.5;
   const double fy = uv.y() * height_ - 0.5;

@@ -552,7 +552,7 @@ Eigen::Vector3d PathTracer::exit_radiance(const SurfacePoint& point, const Eigen
 Eigen::Matrix3Xf path_trace_image(const PathTracer& tracer, const Eigen::Matrix3Xf& origins,
                                   const Eigen::Matrix3Xf& directions, int spp,
                                   const std::function<void(std::uint64_t, std::uint64_t)>& progress,
-                                  std::uint64_t first_key) {
+                                  std::uint64_t first_key, std::uint8_t* hit) {
   if (origins.cols() != directions.cols()) {
     throw std::invalid_argument("path_trace_image: " + std::to_string(origins.cols()) +
                                 " origins for " + std::to_string(directions.cols()) +
@@ -576,6 +576,7 @@ Eigen::Matrix3Xf path_trace_image(const PathTracer& tracer, const Eigen::Matrix3
     for (Eigen::Index i = 0; i < size; ++i) {
       const Eigen::Vector3d d = directions.col(begin + i).cast<double>().normalized();
       const RayHit& h = hits[std::size_t(i)];
+      if (hit) hit[begin + i] = h.triangle >= 0 ? 1 : 0;
       if (h.triangle < 0) {
         sums[std::size_t(i)] = tracer.probe().lookup(d).cast<double>() * spp;
         continue;

@@ -165,11 +165,13 @@ class PathTracer {
 // hits a back face is black. Parallel over pixels, deterministic for the tracer's seed.
 // `progress` (optional) gets pixels done and total, from one thread at a time. Ray i's paths
 // are keyed by first_key + i, so an image traced in bands (each band's first_key its first
-// ray's index in the whole image) is the image traced at once, to the bit.
+// ray's index in the whole image) is the image traced at once, to the bit. `hit` (optional,
+// one per ray) gets 1 where the ray meets the mesh (either face), else 0: the coverage, from
+// the same intersections.
 Eigen::Matrix3Xf path_trace_image(
     const PathTracer& tracer, const Eigen::Matrix3Xf& origins, const Eigen::Matrix3Xf& directions,
     int spp, const std::function<void(std::uint64_t, std::uint64_t)>& progress = {},
-    std::uint64_t first_key = 0);
+    std::uint64_t first_key = 0, std::uint8_t* hit = nullptr);
 
 // A counter-based random stream (SplitMix64's finaliser over key and counter, Steele et al.,
 // "Fast splittable pseudorandom number generators", 2014): number i of stream `key` is a
